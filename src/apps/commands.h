@@ -1,0 +1,11 @@
+// The `cradle` subcommands: each file under apps/ registers one with the CLI.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace cradle::apps {
+
+void register_build_scene(CLI::App& app);
+void register_model_info(CLI::App& app);
+
+}  // namespace cradle::apps

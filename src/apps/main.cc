@@ -1,0 +1,28 @@
+// `cradle`: the command-line entry point. User errors print one line and exit 1; nothing a user
+// types may crash the program.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "apps/commands.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Cradle: the BabyBench infant benchmark (MIMo in MuJoCo), in C++."};
+  app.set_version_flag("--version", CRADLE_VERSION);
+  app.require_subcommand(1);
+  cradle::apps::register_build_scene(app);
+  cradle::apps::register_model_info(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const cradle::UserError& e) {
+    std::fprintf(stderr, "cradle: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cradle: internal error: %s\n", e.what());
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,56 @@
+// Building blocks shared by the v1 and v2 tables (internal to src/model).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "model/infant.h"
+
+namespace cradle::model {
+
+enum class Side { kRight, kLeft };
+inline std::string side_prefix(Side side) { return side == Side::kRight ? "right_" : "left_"; }
+inline const char* side_name(Side side) { return side == Side::kRight ? "right" : "left"; }
+
+Geom sphere(std::string name, double radius, Vec3 pos, double mass, std::string material);
+Geom capsule(std::string name, std::vector<double> size, Vec3 pos, Vec3 euler, double mass,
+             std::string material);
+Geom cylinder(std::string name, std::vector<double> size, Vec3 pos, Vec3 euler, double mass,
+              std::string material);
+Geom box(std::string name, std::vector<double> size, Vec3 pos, Vec3 euler, double mass,
+         std::string material);
+// A hinge; range and springref in degrees.
+Joint hinge(std::string name, Vec3 axis, Vec3 pos, double lo, double hi, double springref,
+            double stiffness, double damping, double frictionloss, double armature);
+
+// Masses that v2 re-tuned (kg); the defaults are v1's.
+struct TrunkMasses {
+  double lb = 1.1584, cb = 1.3245, ub1 = 1.0882, ub2 = .9499, ub3 = .7217, head = 1.7748;
+  double eye = .006275;
+};
+struct LegMasses {
+  double thigh = .7998, shank1 = .3341, shank2 = .1160;
+};
+
+// hip, lower_body, upper_body, head and both eyes (with their cameras).
+void add_trunk_and_head(Infant& infant, const TrunkMasses& masses);
+// Upper and lower arm of one side.
+void add_arm(Infant& infant, Side side, double upper_mass, double lower_mass);
+// Upper and lower leg of one side.
+void add_leg(Infant& infant, Side side, const LegMasses& masses);
+// The three ankle hinges of one foot.
+std::vector<Joint> ankle_joints(Side side);
+
+// Actuators common to both versions, appended in BabyBench group order.
+void add_body_head_eye_actuators(Infant& infant);
+void add_arm_actuators(Infant& infant);
+void add_hand_actuators(Infant& infant);
+void add_leg_actuators(Infant& infant);
+void add_ankle_actuators(Infant& infant, Side side);
+
+// Torque sensors of the head, eyes and trunk (the first five of the reference order).
+void add_head_and_trunk_sensors(Infant& infant);
+// Trunk-coupling and head-limit tendons, the hip/torso contact pair and eye exclusions.
+void add_tendons_and_contacts(Infant& infant);
+
+}  // namespace cradle::model

@@ -1,0 +1,48 @@
+// The composer: config -> one self-contained MJCF scene (infant + world) -> compiled mjModel.
+// The scene text and its generated texture files can be written to a folder (scene.xml beside
+// tex_*.png) or compiled straight from memory through MuJoCo's virtual file system.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/config.h"
+#include "model/infant.h"
+
+namespace cradle::scene {
+
+struct SceneFiles {
+  std::string xml;                                                        // scene.xml
+  std::vector<std::pair<std::string, std::vector<std::uint8_t>>> assets;  // file name -> bytes
+};
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+
+// MIMo version a behaviour uses: v2 (five fingers) for hand regard, v1 otherwise.
+model::MimoVersion mimo_version_for(Behavior behavior);
+
+// The scene for a config; the config is embedded as a YAML comment at the top.
+SceneFiles compose_scene(const Config& config);
+
+// Compiles from memory. Throws std::runtime_error with MuJoCo's message on failure.
+ModelPtr compile_scene(const SceneFiles& scene);
+
+// Writes scene.xml and its texture files into dir (created if missing). Throws UserError if the
+// folder cannot be written.
+void write_scene(const SceneFiles& scene, const std::filesystem::path& dir);
+
+// Loads a scene.xml written by write_scene (or any MJCF file). Throws UserError naming the file.
+ModelPtr load_scene(const std::filesystem::path& file);
+
+inline constexpr const char* kSceneFileName = "scene.xml";
+
+}  // namespace cradle::scene
