@@ -27,26 +27,32 @@ Attrs geom_attrs(const Geom& g) {
   return a;
 }
 
-Attrs joint_attrs(const Joint& j) {
+// Muscle actuation replaces the passive spring and most of the damping with the muscles' own
+// passive and velocity-dependent forces (mimo_core.md §3.2).
+constexpr double kMuscleDampingDivisor = 20;
+
+Attrs joint_attrs(const Joint& j, bool muscle) {
+  const double stiffness = muscle ? 0 : j.stiffness;
+  const double damping = muscle ? j.damping / kMuscleDampingDivisor : j.damping;
   return {{"name", kJointPrefix + j.name},
           {"type", "hinge"},
           {"axis", vec(j.axis)},
           {"pos", vec(j.pos)},
           {"range", nums({j.range_lo, j.range_hi})},
           {"springref", num(j.springref)},
-          {"stiffness", num(j.stiffness)},
-          {"damping", num(j.damping)},
+          {"stiffness", num(stiffness)},
+          {"damping", num(damping)},
           {"frictionloss", num(j.frictionloss)},
           {"armature", num(j.armature)}};
 }
 
 // Emits one body and, recursively, its children in table order (which keeps document order).
-void emit_body(const Infant& infant, const Body& body, XmlWriter& xml) {
+void emit_body(const Infant& infant, const Body& body, bool muscle, XmlWriter& xml) {
   Attrs attrs{{"name", body.name}, {"pos", vec(body.pos)}};
   if (body.euler != Vec3{0, 0, 0}) attrs.emplace_back("euler", vec(body.euler));
   if (body.parent.empty()) attrs.emplace_back("childclass", "mimo");
   xml.open("body", attrs);
-  for (const Joint& j : body.joints) xml.leaf("joint", joint_attrs(j));
+  for (const Joint& j : body.joints) xml.leaf("joint", joint_attrs(j, muscle));
   for (const Geom& g : body.geoms) xml.leaf("geom", geom_attrs(g));
   for (const Site& s : body.sites) {
     xml.leaf("site", {{"name", s.name}, {"pos", vec(s.pos)}, {"size", num(s.radius)}});
@@ -59,7 +65,7 @@ void emit_body(const Infant& infant, const Body& body, XmlWriter& xml) {
                         {"fovy", num(c.fovy)}});
   }
   for (const Body& child : infant.bodies) {
-    if (child.parent == body.name) emit_body(infant, child, xml);
+    if (child.parent == body.name) emit_body(infant, child, muscle, xml);
   }
   xml.close();
 }
@@ -100,7 +106,8 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
 
   // Kinematic tree from the root body.
   XmlWriter body(2);
-  emit_body(infant, infant.bodies.front(), body);
+  const bool muscle = options.actuation == ActuationModel::kMuscle;
+  emit_body(infant, infant.bodies.front(), muscle, body);
   out.body = body.str();
 
   XmlWriter contact;
@@ -150,12 +157,18 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
                                  {"forcelimited", "true"},
                                  {"forcerange", nums({a.gear * a.force_lo, a.gear * a.force_hi})}});
     } else {
-      actuator.leaf("motor", {{"name", name},
-                              {"class", "mimo"},
-                              {"joint", joint},
-                              {"gear", num(a.gear)},
-                              {"forcerange", nums({a.force_lo, a.force_hi})},
-                              {"user", nums({a.user[0], a.user[1], a.user[2]})}});
+      Attrs attrs{{"name", name},
+                  {"class", "mimo"},
+                  {"joint", joint},
+                  {"gear", num(a.gear)},
+                  {"forcerange", nums({a.force_lo, a.force_hi})},
+                  {"user", nums({a.user[0], a.user[1], a.user[2]})}};
+      // The muscle model computes the joint torque itself and sends ctrl = torque / gear.
+      if (muscle) {
+        attrs.emplace_back("ctrllimited", "false");
+        attrs.emplace_back("forcelimited", "false");
+      }
+      actuator.leaf("motor", attrs);
     }
   }
   out.actuator = actuator.str();
