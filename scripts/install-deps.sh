@@ -5,9 +5,12 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libmujoco-dev libmujoco-samples
-  libosmesa6-dev libegl-dev libgl-dev
+  libosmesa6-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libstb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  zlib1g-dev
+  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
+  python3 python3-numpy
 )
 
 missing=()

@@ -7,5 +7,6 @@ namespace cradle::apps {
 
 void register_build_scene(CLI::App& app);
 void register_model_info(CLI::App& app);
+void register_bench(CLI::App& app);
 
 }  // namespace cradle::apps

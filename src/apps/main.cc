@@ -2,17 +2,23 @@
 // types may crash the program.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 
 #include "apps/commands.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {
+  // Mesa's software rasterizer spawns its own threads by default; at eye resolutions they only
+  // slow rendering down, most of all when several envs render in parallel. A user's own
+  // setting wins. Mesa reads it once, so it is set before any GL context exists.
+  setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
   CLI::App app{"Cradle: the BabyBench infant benchmark (MIMo in MuJoCo), in C++."};
   app.set_version_flag("--version", CRADLE_VERSION);
   app.require_subcommand(1);
   cradle::apps::register_build_scene(app);
   cradle::apps::register_model_info(app);
+  cradle::apps::register_bench(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

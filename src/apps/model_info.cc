@@ -5,8 +5,10 @@
 
 #include "apps/commands.h"
 #include "core/config.h"
+#include "envs/babybench.h"
 #include "scene/compose.h"
 #include "scene/summary.h"
+#include "sim/actuation.h"
 
 namespace cradle::apps {
 
@@ -21,10 +23,20 @@ void register_model_info(CLI::App& app) {
   cmd->add_flag("--json", opts->json, "Print one JSON object");
   cmd->callback([opts] {
     const Config config = load_config(opts->config);
-    const scene::ModelPtr model = scene::compile_scene(scene::compose_scene(config));
-    const scene::ModelSummary s = scene::summarize(model.get());
+    const auto assets = envs::make_assets(config);
+    const scene::ModelSummary s = scene::summarize(assets->model.get());
+    // Spaces come from the same code the env uses, without building an env (no GL needed).
+    const auto actuation = sim::make_actuation(config.actuation_model, assets->model.get());
+    const DictSpace obs = envs::babybench_observation_space(*assets, actuation->observation_size());
+    nlohmann::ordered_json sizes;
+    for (const auto& [key, box] : obs.entries) sizes[key] = box.size();
+    const int action_dim = actuation->action_space().size();
     if (opts->json) {
-      std::printf("%s\n", scene::to_json(s).dump(2).c_str());
+      nlohmann::json j = scene::to_json(s);
+      j["action_dim"] = action_dim;
+      j["observation_sizes"] = sizes;
+      if (assets->touch) j["touch_sensors"] = assets->touch->sensor_count();
+      std::printf("%s\n", j.dump(2).c_str());
       return;
     }
     std::printf("MIMo %s in scene '%s' (behavior %s, actuation %s)\n", s.mimo_version.c_str(),
@@ -37,6 +49,7 @@ void register_model_info(CLI::App& app) {
     std::printf("  MuJoCo: nq %d, nv %d, nu %d, nbody %d, ngeom %d, neq %d, ncam %d\n", s.nq, s.nv,
                 s.nu, s.nbody, s.ngeom, s.neq, s.ncam);
     std::printf("  texture data %.2f MB, timestep %g s\n", s.ntexdata / 1e6, s.timestep);
+    std::printf("  action dim %d; observation sizes %s\n", action_dim, sizes.dump().c_str());
   });
 }
 

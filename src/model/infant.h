@@ -114,9 +114,15 @@ struct Infant {
   std::vector<FixedTendon> tendons;
   std::vector<ContactPair> pairs;
   std::vector<ContactExclude> excludes;
-  // Extra solimp for the per-joint lock equalities (v2 stiffens them); empty: MuJoCo default.
-  std::vector<double> lock_solimp;
 };
+
+// Solver parameters of every joint lock (and of the cubes scene's sitting constraints), as stiff
+// as MuJoCo allows: impedance at its 0.9999 cap and the shortest time constant it accepts at a
+// 5 ms step (2 steps). The reference uses MuJoCo's defaults (v1) or solimp 0.95 0.99999 (v2), under
+// which a locked joint sags by up to 0.013 rad; here locked joints stay within 1e-6 rad at rest
+// and within about 1.5e-3 rad under full random effort of every other joint.
+inline constexpr std::array<double, 5> kLockSolimp = {0.9999, 0.9999, 0.001, 0.5, 2};
+inline constexpr std::array<double, 2> kLockSolref = {0.01, 1};
 
 Infant make_mimo_v1();
 Infant make_mimo_v2();

@@ -124,9 +124,6 @@ Infant make_mimo_v1() {
   }
 
   add_tendons_and_contacts(infant);
-  // Locks use v2's stiff impedance in v1 too: MuJoCo's default lets a locked joint sag by
-  // several mrad under gravity and its own spring, and a lock should hold within 1e-3 rad.
-  infant.lock_solimp = {0.95, 0.99999, 0.001, 0.5, 2};
   return infant;
 }
 

@@ -368,8 +368,6 @@ Infant make_mimo_v2() {
   }
 
   add_tendons_and_contacts(infant);
-  // v2 stiffens the per-joint lock equalities.
-  infant.lock_solimp = {0.95, 0.99999, 0.001, 0.5, 2};
   return infant;
 }
 

@@ -183,7 +183,8 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
                   {"joint1", kJointPrefix + j.name},
                   {"polycoef", "0 1 0 0 0"},
                   {"active", active ? "true" : "false"}};
-      if (!infant.lock_solimp.empty()) attrs.emplace_back("solimp", nums(infant.lock_solimp));
+      attrs.emplace_back("solimp", nums(kLockSolimp));
+      attrs.emplace_back("solref", nums(kLockSolref));
       equality.leaf("joint", attrs);
     }
   }

@@ -5,17 +5,12 @@
 #include <cstdio>
 #include <string_view>
 
+#include "core/xml.h"
+
 namespace cradle::scene {
 namespace {
 
-// Shortest faithful text for a number in an MJCF attribute.
-std::string num(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", value);
-  return text;
-}
-
-std::string vec(double x, double y, double z) { return num(x) + " " + num(y) + " " + num(z); }
+std::string vec(double x, double y, double z) { return nums({x, y, z}); }
 
 // Teal rug pattern: a woven teal ground, a lighter diamond lattice and cream dots at the diamond
 // centres. Four lattice periods per image side, so the image tiles seamlessly.
@@ -184,12 +179,13 @@ WorldFragments cubes_world() {
         "\" density=\"200\" material=\"" + std::string(toy.material) + "\"/>\n</body>\n";
   }
   // MIMo's root is welded in place; polycoef is not angle-converted, so the locks are radians.
-  // The locks use v2's stiff lock impedance: with MuJoCo's default they sag by up to 0.013 rad
-  // under gravity and the joint springs, and the sitting pose should hold within 1e-3 rad.
+  // The locks use the infant's stiff lock parameters: with MuJoCo's defaults they sag by up to
+  // 0.013 rad under gravity and the joint springs, and the sitting pose should hold within 1e-3.
   cubes.equality = "<weld body1=\"mimo_location\"/>\n";
   for (const JointLock& lock : kSittingLocks) {
     cubes.equality += "<joint joint1=\"robot:" + std::string(lock.joint) + "\" polycoef=\"" +
-                      num(lock.angle) + " 0 0 0 0\" solimp=\"0.95 0.99999 0.001 0.5 2\"/>\n";
+                      num(lock.angle) + " 0 0 0 0\" solimp=\"" + nums(model::kLockSolimp) +
+                      "\" solref=\"" + nums(model::kLockSolref) + "\"/>\n";
   }
   return cubes;
 }

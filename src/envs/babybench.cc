@@ -1,0 +1,160 @@
+#include "envs/babybench.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+
+namespace cradle::envs {
+namespace {
+
+senses::ProprioOptions proprio_options(const Config& c) {
+  return {.velocity = c.proprio_velocity,
+          .torque = c.proprio_torque,
+          .limits = c.proprio_limits,
+          .actuation = c.proprio_actuation};
+}
+
+double seconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
+
+}  // namespace
+
+DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size) {
+  const Config& c = assets.config;
+  const mjModel* m = assets.model.get();
+  // Keys in the reference's order: proprioception, touch, eyes, vestibular.
+  DictSpace space;
+  space.entries.emplace_back(
+      BabyBenchEnv::kProprioKey,
+      senses::Proprioception(m, proprio_options(c), actuation_obs_size).space());
+  if (assets.touch) space.entries.emplace_back(BabyBenchEnv::kTouchKey, assets.touch->space());
+  if (c.vision_active) {
+    const Box eye = senses::Eyes::space_for(c.vision_resolution);
+    space.entries.emplace_back(BabyBenchEnv::kEyeLeftKey, eye);
+    space.entries.emplace_back(BabyBenchEnv::kEyeRightKey, eye);
+  }
+  if (c.vestibular_active) {
+    space.entries.emplace_back(BabyBenchEnv::kVestibularKey, senses::Vestibular(m).space());
+  }
+  return space;
+}
+
+std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config) {
+  auto assets = std::make_shared<BabyBenchAssets>();
+  assets->config = config;
+  assets->scene = scene::compose_scene(config);
+  assets->model = scene::compile_scene(assets->scene);
+  const mjModel* m = assets->model.get();
+
+  if (config.touch_enabled()) {
+    senses::TouchOptions touch{
+        .body_scales = senses::default_touch_scales(scene::mimo_version_for(config.behavior),
+                                                    config.touch_groups, config.touch_scale),
+        .function = config.touch_function,
+        .response = config.touch_response};
+    if (!touch.body_scales.empty()) assets->touch = std::make_unique<senses::Touch>(m, touch);
+  }
+
+  // Let the pose settle under zero action (locks already hold from the compiled model on).
+  sim::Sim sim(m, config.actuation_model, 1);
+  const std::vector<double> zero(sim.actuation().action_space().size(), 0.0);
+  for (int i = 0; i < BabyBenchEnv::kSettleSteps; ++i) sim.step(zero);
+  sim.save(assets->settled);
+  return assets;
+}
+
+BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::uint64_t seed)
+    : assets_(std::move(assets)),
+      sim_(assets_->model.get(), assets_->config.actuation_model, assets_->config.frame_skip),
+      proprio_(assets_->model.get(), proprio_options(assets_->config),
+               sim_.actuation().observation_size()),
+      task_(make_behaviour(assets_->config, assets_->model.get())),
+      observation_space_(
+          babybench_observation_space(*assets_, sim_.actuation().observation_size())),
+      obs_(observation_space_),
+      proprio_index_(key_index(kProprioKey)),
+      touch_index_(key_index(kTouchKey)),
+      eye_left_index_(key_index(kEyeLeftKey)),
+      eye_right_index_(key_index(kEyeRightKey)),
+      vestibular_index_(key_index(kVestibularKey)),
+      rng_(seed) {
+  const Config& c = assets_->config;
+  const mjModel* m = assets_->model.get();
+  if (c.vestibular_active) vestibular_.emplace(m);
+  if (c.vision_active) eyes_ = std::make_unique<senses::Eyes>(m, c.vision_resolution);
+  random_action_.resize(action_space().size());
+
+  sim_.restore(assets_->settled);
+  observe();
+}
+
+int BabyBenchEnv::key_index(std::string_view key) const {
+  for (int i = 0; i < static_cast<int>(observation_space_.entries.size()); ++i) {
+    if (observation_space_.entries[i].first == key) return i;
+  }
+  return -1;
+}
+
+void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
+  if (seed) rng_.seed_with(*seed);
+  sim_.reset();
+  sim_.restore(assets_->settled);
+
+  // Random start: a few random actions drawn from the env's own (seeded) generator.
+  const Box& space = action_space();
+  for (int i = 0; i < kRandomResetSteps; ++i) {
+    for (size_t k = 0; k < random_action_.size(); ++k) {
+      random_action_[k] = rng_.uniform(space.low[k], space.high[k]);
+    }
+    sim_.step(random_action_);
+  }
+  steps_ = 0;
+  info_ = Info{};
+  task_->reset(model(), sim_.data(), info_);
+  observe();
+}
+
+StepResult BabyBenchEnv::step(std::span<const double> action) {
+  const Clock::time_point start = Clock::now();
+  sim_.step(action);
+  profile_.physics += seconds(Clock::now() - start);
+  observe();
+
+  const Clock::time_point task_start = Clock::now();
+  info_.steps = steps_;
+  StepResult result;
+  result.reward = task_->after_step(model(), sim_.data(), info_);
+  ++steps_;
+  result.truncated = steps_ >= assets_->config.max_episode_steps;
+  profile_.other += seconds(Clock::now() - task_start);
+  ++profile_.steps;
+  return result;
+}
+
+void BabyBenchEnv::observe() {
+  const mjModel* m = model();
+  mjData* d = sim_.data();
+  Clock::time_point t = Clock::now();
+  auto lap = [&](double& bucket) {
+    const Clock::time_point now = Clock::now();
+    bucket += seconds(now - t);
+    t = now;
+  };
+  proprio_.read(m, d, sim_.actuation(), obs_.f64(proprio_index_));
+  lap(profile_.proprio);
+  if (touch_index_ >= 0) {
+    touch()->read(m, d, obs_.f32(touch_index_));
+    lap(profile_.touch);
+  }
+  if (eyes_) {
+    eyes_->render(m, d, obs_.u8(eye_left_index_), obs_.u8(eye_right_index_));
+    lap(profile_.vision);
+  }
+  if (vestibular_) {
+    vestibular_->read(d, obs_.f64(vestibular_index_));
+    lap(profile_.vestibular);
+  }
+}
+
+}  // namespace cradle::envs

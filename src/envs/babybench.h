@@ -1,0 +1,98 @@
+// The BabyBench env: MIMo's simulation, his senses and a behaviour, configured by a BabyBench
+// YAML config. Everything a config compiles to once (model, touch sensor layout, settled start
+// state) lives in BabyBenchAssets and is shared read-only by every env built from it.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/rng.h"
+#include "envs/env.h"
+#include "envs/task.h"
+#include "scene/compose.h"
+#include "senses/proprioception.h"
+#include "senses/touch.h"
+#include "senses/vestibular.h"
+#include "senses/vision.h"
+#include "sim/sim.h"
+
+namespace cradle::envs {
+
+struct BabyBenchAssets {
+  Config config;
+  scene::SceneFiles scene;  // what compiled `model`; written as scene.xml in training mode
+  scene::ModelPtr model;
+  std::unique_ptr<senses::Touch> touch;  // null when touch is off
+  sim::State settled;  // after 100 zero-action physics steps: every episode starts here
+};
+
+// Compiles the config's scene, lays out the skin and settles the pose. Throws UserError for
+// configs that cannot run.
+std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config);
+
+// The observation space a config produces, without building an env (no GL context needed).
+DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size);
+
+// Wall time per env step spent in each module (for `cradle bench`).
+struct Profile {
+  double physics = 0, touch = 0, vision = 0, proprio = 0, vestibular = 0, other = 0;  // seconds
+  long steps = 0;
+};
+
+class BabyBenchEnv final : public Env {
+ public:
+  // Observation keys, in the reference's order.
+  static constexpr const char* kProprioKey = "observation";
+  static constexpr const char* kTouchKey = "touch";
+  static constexpr const char* kEyeLeftKey = "eye_left";
+  static constexpr const char* kEyeRightKey = "eye_right";
+  static constexpr const char* kVestibularKey = "vestibular";
+
+  static constexpr int kSettleSteps = 100;      // zero-action physics steps at construction
+  static constexpr int kRandomResetSteps = 10;  // random actions applied at every reset
+
+  explicit BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::uint64_t seed = 0);
+
+  const DictSpace& observation_space() const override { return observation_space_; }
+  const Box& action_space() const override { return sim_.actuation().action_space(); }
+  void reset(std::optional<std::uint64_t> seed = std::nullopt) override;
+  StepResult step(std::span<const double> action) override;
+  const ObservationBuffers& observation() const override { return obs_; }
+  const Info& info() const override { return info_; }
+
+  const Config& config() const { return assets_->config; }
+  const mjModel* model() const { return assets_->model.get(); }
+  const mjData* data() const { return sim_.data(); }
+  const senses::Touch* touch() const { return assets_->touch.get(); }
+  const senses::Proprioception& proprioception() const { return proprio_; }
+  int episode_steps() const { return steps_; }
+  const Profile& profile() const { return profile_; }
+  void clear_profile() { profile_ = {}; }
+  // Index of an observation key in observation_space() (-1 if absent).
+  int key_index(std::string_view key) const;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  void observe();
+
+  std::shared_ptr<const BabyBenchAssets> assets_;
+  sim::Sim sim_;
+  senses::Proprioception proprio_;
+  std::optional<senses::Vestibular> vestibular_;
+  std::unique_ptr<senses::Eyes> eyes_;
+  std::unique_ptr<Task> task_;
+  DictSpace observation_space_;
+  ObservationBuffers obs_;
+  const int proprio_index_, touch_index_, eye_left_index_, eye_right_index_, vestibular_index_;
+  Info info_;
+  Rng rng_;
+  std::vector<double> random_action_;
+  int steps_ = 0;
+  Profile profile_;
+};
+
+}  // namespace cradle::envs

@@ -1,0 +1,77 @@
+#include "envs/self_touch.h"
+
+#include <string_view>
+
+#include "scene/summary.h"
+
+namespace cradle::envs {
+namespace {
+
+// The hand body itself and every body below it (fingers).
+std::vector<int> hand_bodies(const mjModel* m, const char* hand) {
+  return scene::subtree_bodies(m, hand);
+}
+
+}  // namespace
+
+SelfTouch::SelfTouch(const mjModel* m) : hand_of_geom_(m->ngeom, -1), is_mimo_(m->ngeom, 0) {
+  for (int body : scene::subtree_bodies(m, "hip")) {
+    for (int g = m->body_geomadr[body]; g < m->body_geomadr[body] + m->body_geomnum[body]; ++g) {
+      is_mimo_[g] = 1;
+    }
+  }
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (is_mimo_[g]) mimo_geoms_.push_back(g);
+  }
+  const char* hands[2] = {"right_hand", "left_hand"};
+  for (int h = 0; h < 2; ++h) {
+    for (int body : hand_bodies(m, hands[h])) {
+      for (int g = m->body_geomadr[body]; g < m->body_geomadr[body] + m->body_geomnum[body]; ++g) {
+        hand_of_geom_[g] = h;
+        hand_geoms_[h].push_back(g);
+      }
+    }
+    seen_[h].assign(m->ngeom, 0);
+  }
+}
+
+void SelfTouch::reset(const mjModel* m, const mjData*, Info& info) {
+  for (int h = 0; h < 2; ++h) seen_[h].assign(m->ngeom, 0);
+  // Capacity for every geom, so recording never allocates during an episode.
+  info.right_hand_touches.clear();
+  info.left_hand_touches.clear();
+  info.right_hand_touches.reserve(m->ngeom);
+  info.left_hand_touches.reserve(m->ngeom);
+}
+
+void SelfTouch::record(int hand, int other, Info& info) {
+  // Only MIMo's own geoms count, never the hand's own (palm and fingers).
+  if (!is_mimo_[other] || hand_of_geom_[other] == hand || seen_[hand][other]) return;
+  seen_[hand][other] = 1;
+  (hand == 0 ? info.right_hand_touches : info.left_hand_touches).push_back(other);
+}
+
+double SelfTouch::after_step(const mjModel*, const mjData* d, Info& info) {
+  for (int i = 0; i < d->ncon; ++i) {
+    const int g1 = d->contact[i].geom1;
+    const int g2 = d->contact[i].geom2;
+    // Each side of the contact is tested for each hand, so both hands record symmetrically.
+    if (hand_of_geom_[g1] >= 0) record(hand_of_geom_[g1], g2, info);
+    if (hand_of_geom_[g2] >= 0) record(hand_of_geom_[g2], g1, info);
+  }
+  return 0;
+}
+
+std::string geom_label(const mjModel* m, int geom) {
+  const int body = m->geom_bodyid[geom];
+  const char* body_name = mj_id2name(m, mjOBJ_BODY, body);
+  std::string label(body_name ? body_name : "world");
+  if (const char* name = mj_id2name(m, mjOBJ_GEOM, geom)) {
+    label.append("/").append(name);
+  } else if (m->body_geomnum[body] > 1) {
+    label.append("#").append(std::to_string(geom - m->body_geomadr[body]));
+  }
+  return label;
+}
+
+}  // namespace cradle::envs

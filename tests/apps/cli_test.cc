@@ -1,0 +1,111 @@
+// The `cradle` binary end to end: exit codes, one-line errors, written files, JSON output.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+CliResult cradle(const std::string& args) {
+  const std::string cmd = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
+  r.status = WEXITSTATUS(pclose(pipe));
+  return r;
+}
+
+std::string config(const char* name) {
+  return (fs::path(CRADLE_SOURCE_DIR) / "configs" / name).string();
+}
+
+fs::path temp_dir(const char* tag) {
+  const fs::path dir = fs::temp_directory_path() /
+                       (std::string("cradle_cli_") + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(Cli, BuildSceneWritesSceneAndTextures) {
+  const fs::path dir = temp_dir("build");
+  const CliResult r =
+      cradle("build-scene --config " + config("config_selftouch.yml") + " --out " + dir.string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "scene.xml"));
+  EXPECT_TRUE(fs::exists(dir / "tex_head_default_right.png"));
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ModelInfoJsonHasReferenceCounts) {
+  const CliResult r = cradle("model-info --json --config " + config("config_handregard.yml"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mimo_version"], "v2");
+  EXPECT_EQ(j["n_joints"], 91);
+  EXPECT_EQ(j["n_actuators"], 17);
+  EXPECT_EQ(j["n_torque_sensors"], 53);
+  EXPECT_EQ(j["n_bodies"], 54);
+  EXPECT_EQ(j["n_geoms"], 74);
+  EXPECT_NEAR(j["total_mass"].get<double>(), 10.89991, 0.01);
+  EXPECT_NEAR(j["height"].get<double>(), 0.778, 0.008);
+  EXPECT_EQ(j["nu"], 17);
+  EXPECT_EQ(j["action_dim"], 17);
+  EXPECT_EQ(j["observation_sizes"]["observation"], 466);
+  EXPECT_EQ(j["observation_sizes"]["eye_left"], 64 * 64 * 3);
+}
+
+// Bad input: one line naming the problem, a non-zero exit, no crash.
+TEST(Cli, BadConfigGivesOneLineError) {
+  const fs::path dir = temp_dir("bad");
+  std::ofstream(dir / "bad.yml") << "scene: kitchen\n";
+  CliResult r = cradle("model-info --config " + (dir / "bad.yml").string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find("scene"), std::string::npos);
+  EXPECT_NE(r.out.find("kitchen"), std::string::npos);
+
+  r = cradle("model-info --config " + (dir / "missing.yml").string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find("missing.yml"), std::string::npos);
+
+  r = cradle("bench --steps 0 --config " + config("config_selftouch.yml"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("--steps"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, BenchJsonReportsRatesAndModules) {
+  const CliResult r = cradle("bench --json --steps 200 --config " + config("config_selftouch.yml"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["env_steps_per_s"].get<double>(), 0);
+  EXPECT_GT(j["bare_steps_per_s"].get<double>(), 0);
+  EXPECT_GT(j["ratio"].get<double>(), 0.5);
+  for (const char* module : {"physics", "touch", "vision", "proprioception", "vestibular"}) {
+    EXPECT_TRUE(j["modules_us"].contains(module)) << module;
+  }
+  EXPECT_GT(j["modules_us"]["touch"].get<double>(), 0);
+  EXPECT_EQ(j["modules_us"]["vision"].get<double>(), 0);  // vision is off in this config
+}
+
+}  // namespace
