@@ -2,7 +2,9 @@
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
-CONFIG ?= configs/config_test_installation.yml
+CONFIG ?= configs/config_selftouch.yml
+STEPS ?= 20000
+EPISODES ?= 2
 
 .PHONY: all deps configure build run test install format clean
 
@@ -17,9 +19,11 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
+# The main job: installation test, a random-policy baseline on CONFIG, then its evaluation.
 run: build
-	@$(BUILD_DIR)/cradle build-scene --config $(CONFIG)
-	@$(BUILD_DIR)/cradle model-info --config $(CONFIG)
+	@$(BUILD_DIR)/cradle test-installation
+	@$(BUILD_DIR)/cradle random --config $(CONFIG) --train_for $(STEPS)
+	@$(BUILD_DIR)/cradle evaluate --config $(CONFIG) --episodes $(EPISODES)
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

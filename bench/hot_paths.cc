@@ -18,9 +18,9 @@ std::shared_ptr<const envs::BabyBenchAssets> assets_for(const char* name, bool v
 }
 
 // A started env whose state has been moved by some random steps.
-envs::BabyBenchEnv started(std::shared_ptr<const envs::BabyBenchAssets> assets) {
-  envs::BabyBenchEnv env(std::move(assets));
-  env.reset(0);
+std::unique_ptr<envs::BabyBenchEnv> started(std::shared_ptr<const envs::BabyBenchAssets> assets) {
+  auto env = std::make_unique<envs::BabyBenchEnv>(std::move(assets));
+  env->reset(0);
   return env;
 }
 
@@ -47,13 +47,13 @@ BENCHMARK(BM_TouchReadSelfTouch);
 
 void BM_EnvStep(benchmark::State& state, const char* config, bool vision) {
   auto env = started(assets_for(config, vision));
-  std::vector<double> action(env.action_space().size());
+  std::vector<double> action(env->action_space().size());
   Rng rng(1);
   for (auto _ : state) {
     for (size_t k = 0; k < action.size(); ++k) {
-      action[k] = rng.uniform(env.action_space().low[k], env.action_space().high[k]);
+      action[k] = rng.uniform(env->action_space().low[k], env->action_space().high[k]);
     }
-    if (env.step(action).truncated) env.reset();
+    if (env->step(action).truncated) env->reset();
   }
 }
 BENCHMARK_CAPTURE(BM_EnvStep, self_touch, "config_selftouch.yml", false);

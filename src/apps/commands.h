@@ -8,5 +8,8 @@ namespace cradle::apps {
 void register_build_scene(CLI::App& app);
 void register_model_info(CLI::App& app);
 void register_bench(CLI::App& app);
+void register_random(CLI::App& app);
+void register_evaluate(CLI::App& app);
+void register_test_installation(CLI::App& app);
 
 }  // namespace cradle::apps

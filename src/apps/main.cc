@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
   cradle::apps::register_build_scene(app);
   cradle::apps::register_model_info(app);
   cradle::apps::register_bench(app);
+  cradle::apps::register_random(app);
+  cradle::apps::register_evaluate(app);
+  cradle::apps::register_test_installation(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

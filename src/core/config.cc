@@ -610,3 +610,16 @@ std::optional<TouchResponse> touch_response_from_name(std::string_view name) {
 }
 
 }  // namespace cradle
+
+namespace cradle {
+
+Config test_installation_config() {
+  Config c;
+  c.save_dir = "results/test_installation";
+  c.touch_function = TouchFunction::kForceVector;
+  c.touch_response = TouchResponse::kSpreadLinear;
+  c.lock_groups[Group::kFeet] = true;
+  return c;
+}
+
+}  // namespace cradle

@@ -64,6 +64,10 @@ struct Config {
 // The documented defaults (same as a value-initialised Config).
 Config default_config();
 
+// The reference kit's config_test_installation.yml (configs/ holds the same file), built in so
+// `cradle test-installation` needs no file.
+Config test_installation_config();
+
 // Parses YAML text; `source` names the file in error messages. Missing keys keep their defaults;
 // anything present but invalid throws UserError with a one-line message.
 Config parse_config(std::string_view yaml_text, std::string_view source);

@@ -1,6 +1,7 @@
 #include "envs/babybench.h"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "core/error.h"
 
@@ -40,13 +41,12 @@ DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuati
   return space;
 }
 
-std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config) {
-  auto assets = std::make_shared<BabyBenchAssets>();
-  assets->config = config;
-  assets->scene = scene::compose_scene(config);
-  assets->model = scene::compile_scene(assets->scene);
-  const mjModel* m = assets->model.get();
+namespace {
 
+// Lays out the skin and settles the pose of a compiled scene.
+std::shared_ptr<const BabyBenchAssets> finish_assets(std::shared_ptr<BabyBenchAssets> assets) {
+  const Config& config = assets->config;
+  const mjModel* m = assets->model.get();
   if (config.touch_enabled()) {
     senses::TouchOptions touch{
         .body_scales = senses::default_touch_scales(scene::mimo_version_for(config.behavior),
@@ -62,6 +62,24 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config) {
   for (int i = 0; i < BabyBenchEnv::kSettleSteps; ++i) sim.step(zero);
   sim.save(assets->settled);
   return assets;
+}
+
+}  // namespace
+
+std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config) {
+  auto assets = std::make_shared<BabyBenchAssets>();
+  assets->config = config;
+  assets->scene = scene::compose_scene(config);
+  assets->model = scene::compile_scene(assets->scene);
+  return finish_assets(std::move(assets));
+}
+
+std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
+                                                   const std::filesystem::path& scene_file) {
+  auto assets = std::make_shared<BabyBenchAssets>();
+  assets->config = config;
+  assets->model = scene::load_scene(scene_file);
+  return finish_assets(std::move(assets));
 }
 
 BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::uint64_t seed)
@@ -89,6 +107,37 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
   observe();
 }
 
+BabyBenchEnv::~BabyBenchEnv() {
+  try {
+    close();
+  } catch (...) {
+    // Destructors must not throw; call close() to see logging errors.
+  }
+}
+
+void BabyBenchEnv::close() {
+  if (log_ && steps_ > 0) log_->record(info_, steps_);
+  if (log_) log_->flush();
+  log_.reset();
+}
+
+std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets) {
+  const Config& config = assets.config;
+  const std::filesystem::path dir = config.save_dir;
+  scene::write_scene(assets.scene, dir);
+  std::error_code ec;
+  std::filesystem::create_directories(dir / "videos", ec);
+  return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.behavior,
+                                       config.save_logs_every);
+}
+
+std::unique_ptr<BabyBenchEnv> make_env(const Config& config, bool training, std::uint64_t seed) {
+  auto assets = make_assets(config);
+  auto env = std::make_unique<BabyBenchEnv>(assets, seed);
+  if (training) env->attach_log(start_training(*assets));
+  return env;
+}
+
 int BabyBenchEnv::key_index(std::string_view key) const {
   for (int i = 0; i < static_cast<int>(observation_space_.entries.size()); ++i) {
     if (observation_space_.entries[i].first == key) return i;
@@ -97,6 +146,7 @@ int BabyBenchEnv::key_index(std::string_view key) const {
 }
 
 void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
+  if (log_) log_->record(info_, steps_);
   if (seed) rng_.seed_with(*seed);
   sim_.reset();
   sim_.restore(assets_->settled);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "core/rng.h"
 #include "envs/env.h"
 #include "envs/task.h"
+#include "envs/training_log.h"
 #include "scene/compose.h"
 #include "senses/proprioception.h"
 #include "senses/touch.h"
@@ -21,6 +23,11 @@
 #include "sim/sim.h"
 
 namespace cradle::envs {
+
+// Builds an env the way babybench.utils.make_env does. training = true creates <save_dir> with
+// logs/ and videos/, writes scene.xml there and attaches a new training log.
+std::unique_ptr<class BabyBenchEnv> make_env(const Config& config, bool training,
+                                             std::uint64_t seed = 0);
 
 struct BabyBenchAssets {
   Config config;
@@ -33,6 +40,13 @@ struct BabyBenchAssets {
 // Compiles the config's scene, lays out the skin and settles the pose. Throws UserError for
 // configs that cannot run.
 std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config);
+// The same from a scene.xml written by a training run (evaluation reuses the training scene).
+std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
+                                                   const std::filesystem::path& scene_file);
+
+// Prepares <save_dir> for a training run (scene.xml, logs/, videos/) and opens a new training log
+// there, for one env or for every env of a vector.
+std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets);
 
 // The observation space a config produces, without building an env (no GL context needed).
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size);
@@ -56,6 +70,12 @@ class BabyBenchEnv final : public Env {
   static constexpr int kRandomResetSteps = 10;  // random actions applied at every reset
 
   explicit BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::uint64_t seed = 0);
+  ~BabyBenchEnv() override;
+
+  // Training mode: every reset records the episode that just ended (the first reset records a
+  // 0-step entry, as the reference does); close() records the last, partial one.
+  void attach_log(std::shared_ptr<TrainingLog> log) { log_ = std::move(log); }
+  void close();
 
   const DictSpace& observation_space() const override { return observation_space_; }
   const Box& action_space() const override { return sim_.actuation().action_space(); }
@@ -67,6 +87,10 @@ class BabyBenchEnv final : public Env {
   const Config& config() const { return assets_->config; }
   const mjModel* model() const { return assets_->model.get(); }
   const mjData* data() const { return sim_.data(); }
+  // For renderers only: MuJoCo's scene update takes a non-const mjData but does not change the
+  // simulation state.
+  mjData* render_data() const { return const_cast<mjData*>(sim_.data()); }
+  const Task& task() const { return *task_; }
   const senses::Touch* touch() const { return assets_->touch.get(); }
   const senses::Proprioception& proprioception() const { return proprio_; }
   int episode_steps() const { return steps_; }
@@ -85,6 +109,7 @@ class BabyBenchEnv final : public Env {
   std::optional<senses::Vestibular> vestibular_;
   std::unique_ptr<senses::Eyes> eyes_;
   std::unique_ptr<Task> task_;
+  std::shared_ptr<TrainingLog> log_;
   DictSpace observation_space_;
   ObservationBuffers obs_;
   const int proprio_index_, touch_index_, eye_left_index_, eye_right_index_, vestibular_index_;

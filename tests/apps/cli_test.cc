@@ -109,3 +109,86 @@ TEST(Cli, BenchJsonReportsRatesAndModules) {
 }
 
 }  // namespace
+
+namespace {
+
+// ffprobe's frame count, width and height of a video's first stream.
+nlohmann::json probe(const fs::path& video) {
+  const std::string cmd =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=codec_name,width,height,nb_read_frames -of json " +
+      video.string();
+  std::string out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) out += buf;
+  pclose(pipe);
+  return nlohmann::json::parse(out)["streams"][0];
+}
+
+TEST(Cli, TestInstallationWritesSceneLogAndVideo) {
+  const fs::path dir = temp_dir("install");
+  const CliResult r = cradle("test-installation --save-dir " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("passed"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "out" / "scene.xml"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "logs" / "training.jsonl"));
+  const nlohmann::json v = probe(dir / "out" / "videos" / "test_installation.mp4");
+  EXPECT_EQ(v["codec_name"], "h264");
+  EXPECT_EQ(v["width"], 480);
+  EXPECT_EQ(v["height"], 480);
+  EXPECT_EQ(v["nb_read_frames"], "11");
+  fs::remove_all(dir);
+}
+
+// A random baseline writes a log; evaluate, run from another working directory, scores it and
+// writes trajectories, videos, evaluation.json and plots.
+TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
+  const fs::path dir = temp_dir("eval");
+  std::ofstream(dir / "config.yml")
+      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+      << "\nvision_active: False\nmax_episode_steps: 50\n"
+         "touch_function: force_vector\n";
+  CliResult r = cradle("random --config " + (dir / "config.yml").string() + " --train_for 120");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("training score"), std::string::npos) << r.out;
+
+  const fs::path elsewhere = dir / "elsewhere";
+  fs::create_directories(elsewhere);
+  const std::string cmd = "cd " + elsewhere.string() + " && " + std::string(CRADLE_BINARY) +
+                          " evaluate --config ../config.yml --episodes 2 --duration 30 2>&1";
+  std::string out;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) out += buf;
+  ASSERT_EQ(WEXITSTATUS(pclose(pipe)), 0) << out;
+  const fs::path run = dir / "run";
+  for (const char* file :
+       {"evaluation.json", "trajectories/episode_0.npz", "trajectories/episode_1.npz",
+        "plots/training_score.png", "plots/touch_coverage.png"}) {
+    EXPECT_TRUE(fs::exists(run / file)) << file;
+  }
+  const nlohmann::json v = probe(run / "videos" / "episode_1.mp4");
+  EXPECT_EQ(v["width"], 720);
+  EXPECT_EQ(v["height"], 480);
+  EXPECT_EQ(v["nb_read_frames"], "30");
+  // The trajectory loads with numpy: qpos per step and one info dict (JSON) per step.
+  if (fs::exists("/usr/bin/python3")) {
+    const std::string py = "/usr/bin/python3 -c \"import numpy as n, json; d = n.load('" +
+                           (run / "trajectories" / "episode_0.npz").string() +
+                           "'); print(d['qpos'].shape, json.loads(d['info'][-1])['steps'])\"";
+    std::string shape;
+    FILE* p = popen(py.c_str(), "r");
+    while (fgets(buf, sizeof(buf), p)) shape += buf;
+    pclose(p);
+    EXPECT_EQ(shape, "(30, 54) 29\n");
+  }
+  std::ifstream in(run / "evaluation.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["episodes"].size(), 2u);
+  EXPECT_EQ(report["training_log"]["episodes"], 4);  // 0-step entry, 2 full, 1 partial
+  EXPECT_TRUE(report["score"].contains("mean"));
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,70 @@
+// `cradle evaluate --config FILE [--episodes 10] [--duration 1000] [--render | --no-render]
+// [--seed S] [--video-format mp4|avi]`: the reference's evaluation.py, with scores.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "apps/commands.h"
+#include "core/config.h"
+#include "eval/evaluation.h"
+
+namespace cradle::apps {
+
+void register_evaluate(CLI::App& app) {
+  struct Options {
+    std::string config;
+    int episodes = 10;
+    int duration = 1000;
+    bool render = true;
+    std::uint64_t seed = 0;
+    std::string format = "mp4";
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Score the training log, then run evaluation episodes (random policy) and write "
+      "trajectories, videos, evaluation.json and plots under save_dir.\n"
+      "Scores: self-touch = (|geoms touched by right hand| + |by left hand|) / 68, unions over "
+      "the last <= 10,000 logged episodes; hand regard = mean over the 4 eye-hand pairs of the "
+      "fraction of steps in view (reference), and the mean over the eyes of the fraction with "
+      "either hand in view (competition site).");
+  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--episodes", opts->episodes, "Evaluation episodes")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--duration", opts->duration, "Env steps per episode")
+      ->check(CLI::Range(1, 100000000));
+  cmd->add_flag("--render,!--no-render", opts->render, "Write a video per episode (default on)");
+  cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i");
+  cmd->add_option("--video-format", opts->format, "Video container")
+      ->check(CLI::IsMember({"mp4", "avi"}));
+  cmd->callback([opts] {
+    const Config config = load_config(opts->config);
+    eval::EvaluationOptions options{.episodes = opts->episodes,
+                                    .duration = opts->duration,
+                                    .render = opts->render,
+                                    .seed = opts->seed,
+                                    .video_extension = "." + opts->format};
+    const std::string behavior(behavior_name(config.behavior));
+    const eval::EvaluationReport r = eval::evaluate(config, options);
+    if (r.training_score) {
+      std::printf("training log: %d entries, score %.4f\n", r.training_episodes, *r.training_score);
+    } else {
+      std::printf("training log: %s\n",
+                  r.training_episodes ? "no score for behavior none" : "none found");
+    }
+    if (config.behavior != Behavior::kNone) {
+      std::printf("evaluation (%s, %d episodes x %d steps): %.4f +- %.4f\n", behavior.c_str(),
+                  opts->episodes, opts->duration, r.mean, r.std);
+    }
+    if (config.behavior == Behavior::kHandRegard) {
+      double either = 0;
+      for (const auto& e : r.episodes) either += e.hand_regard ? e.hand_regard->either : 0;
+      std::printf("hand regard, either hand in view of each eye: %.4f\n",
+                  either / static_cast<double>(r.episodes.size()));
+    }
+    std::printf("wrote %s/{evaluation.json, trajectories/, %splots/}\n", config.save_dir.c_str(),
+                opts->render ? "videos/, " : "");
+  });
+}
+
+}  // namespace cradle::apps

@@ -1,0 +1,284 @@
+#include "eval/evaluation.h"
+
+#include <mujoco/mujoco.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <set>
+
+#include "core/error.h"
+#include "core/jsonl.h"
+#include "core/npz.h"
+#include "core/rng.h"
+#include "envs/hand_regard.h"
+#include "envs/self_touch.h"
+#include "eval/frames.h"
+#include "eval/plot.h"
+#include "eval/video.h"
+
+namespace cradle::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Per-step record of one episode, for its trajectory file and plots.
+struct Trajectory {
+  std::vector<double> qpos;         // steps x nq
+  std::vector<float> actions;       // steps x action dim
+  std::vector<std::string> infos;   // steps JSON texts
+  std::vector<double> gaze_angles;  // steps x 4 (hand regard)
+};
+
+// Score over training episodes from the log (per-episode score, plus the cumulative union for
+// self-touch).
+void plot_training_log(Behavior behavior, const std::vector<nlohmann::json>& entries,
+                       const fs::path& file) {
+  Series per_episode{.label = "episode score", .color = default_color(0), .points = true};
+  Series cumulative{.label = "union of touches so far", .color = default_color(1)};
+  std::set<int> right, left;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const nlohmann::json& e = entries[i];
+    if (!e.contains("score")) continue;
+    per_episode.x.push_back(static_cast<double>(i));
+    per_episode.y.push_back(e["score"].get<double>());
+    if (behavior == Behavior::kSelfTouch) {
+      for (int g : e.value("right_hand_touches", std::vector<int>{})) right.insert(g);
+      for (int g : e.value("left_hand_touches", std::vector<int>{})) left.insert(g);
+      cumulative.x.push_back(static_cast<double>(i));
+      cumulative.y.push_back(static_cast<double>(right.size() + left.size()) /
+                             kSelfTouchDenominator);
+    }
+  }
+  LinePlot plot{.title = "Training log: score per episode",
+                .x_label = "episode",
+                .y_label = "score",
+                .series = {per_episode}};
+  if (!cumulative.y.empty()) plot.series.push_back(cumulative);
+  write_png(render_line_plot(plot), file);
+}
+
+// Self-touch coverage per body part: fraction of each MIMo body's geoms touched by each hand over
+// the evaluation episodes.
+void plot_coverage(const mjModel* m, const std::vector<EpisodeResult>& episodes,
+                   const fs::path& file) {
+  BarChart chart{.title = "Self-touch coverage per body part (evaluation)",
+                 .y_label = "fraction of geoms touched",
+                 .group_labels = {"right hand", "left hand"},
+                 .values = {{}, {}},
+                 .y_range = std::make_pair(0.0, 1.0)};
+  std::set<int> touched[2];
+  for (const EpisodeResult& e : episodes) {
+    touched[0].insert(e.right_hand_touches.begin(), e.right_hand_touches.end());
+    touched[1].insert(e.left_hand_touches.begin(), e.left_hand_touches.end());
+  }
+  for (int body = 0; body < m->nbody; ++body) {
+    const int first = m->body_geomadr[body], count = m->body_geomnum[body];
+    const char* name = mj_id2name(m, mjOBJ_BODY, body);
+    if (count == 0 || !name) continue;
+    // Only MIMo's bodies: those whose geoms can appear in the touch lists (below "hip").
+    bool mimo = false;
+    for (int b = body; b > 0; b = m->body_parentid[b]) {
+      const char* n = mj_id2name(m, mjOBJ_BODY, b);
+      if (n && std::string(n) == "hip") mimo = true;
+    }
+    if (!mimo) continue;
+    chart.categories.emplace_back(name);
+    for (int hand = 0; hand < 2; ++hand) {
+      int hit = 0;
+      for (int g = first; g < first + count; ++g) hit += static_cast<int>(touched[hand].count(g));
+      chart.values[hand].push_back(static_cast<double>(hit) / count);
+    }
+  }
+  write_png(render_bar_chart(chart, 1200, 600), file);
+}
+
+// Gaze-hand angle over one episode for the four eye-hand pairs, with the threshold.
+void plot_gaze(const std::vector<double>& angles, double half_angle, const fs::path& file) {
+  const char* labels[4] = {"right eye - right hand", "right eye - left hand",
+                           "left eye - right hand", "left eye - left hand"};
+  LinePlot plot{.title = "Gaze-hand angle (evaluation episode 0)",
+                .x_label = "step",
+                .y_label = "angle (°)",
+                .y_range = std::make_pair(0.0, 180.0),
+                .h_lines = {{half_angle, "central field of view"}}};
+  for (int k = 0; k < 4; ++k) {
+    Series s{.label = labels[k], .color = default_color(k)};
+    for (size_t t = 0; 4 * t + k < angles.size(); ++t) s.y.push_back(angles[4 * t + k]);
+    plot.series.push_back(std::move(s));
+  }
+  write_png(render_line_plot(plot), file);
+}
+
+void write_trajectory(const Trajectory& traj, int steps, int nq, int nu, const fs::path& file) {
+  NpzWriter npz(file);
+  const auto n = static_cast<std::size_t>(steps);
+  npz.add("qpos", traj.qpos, {n, static_cast<std::size_t>(nq)});
+  npz.add("action", traj.actions, {n, static_cast<std::size_t>(nu)});
+  npz.add_strings("info", traj.infos);
+  if (!traj.gaze_angles.empty()) npz.add("gaze_angle", traj.gaze_angles, {n, 4});
+  npz.close();
+}
+
+}  // namespace
+
+Policy random_policy(std::uint64_t seed) {
+  auto rng = std::make_shared<Rng>(seed);
+  return [rng](const envs::BabyBenchEnv& env, std::span<double> action) {
+    const Box& space = env.action_space();
+    for (size_t k = 0; k < action.size(); ++k)
+      action[k] = rng->uniform(space.low[k], space.high[k]);
+  };
+}
+
+EvaluationReport evaluate(const Config& config, const EvaluationOptions& options,
+                          const Policy& given_policy) {
+  if (options.episodes < 1) throw UserError("--episodes must be at least 1");
+  if (options.duration < 1) throw UserError("--duration must be at least 1");
+  const fs::path dir = config.save_dir;
+  EvaluationReport report;
+
+  // Training log score, as the reference prints first.
+  const fs::path log_file = dir / "logs" / "training.jsonl";
+  std::vector<nlohmann::json> log;
+  if (fs::exists(log_file)) {
+    log = read_jsonl(log_file);
+    report.training_episodes = static_cast<int>(log.size());
+    report.training_score = training_score(config.behavior, log);
+    if (config.behavior == Behavior::kHandRegard)
+      report.training_hand_regard = hand_regard_score(log);
+  }
+
+  // The training scene when there is one (no re-build), else the config's.
+  const fs::path scene_file = dir / scene::kSceneFileName;
+  auto assets =
+      fs::exists(scene_file) ? envs::make_assets(config, scene_file) : envs::make_assets(config);
+  envs::BabyBenchEnv env(assets, options.seed);
+  const mjModel* m = env.model();
+  const Policy policy = given_policy ? given_policy : random_policy(options.seed ^ 0x5eedULL);
+  const auto* hand_regard = dynamic_cast<const envs::HandRegard*>(&env.task());
+
+  std::error_code ec;
+  for (const char* sub : {"trajectories", "videos", "plots"}) fs::create_directories(dir / sub, ec);
+  std::unique_ptr<FrameComposer> composer;
+  std::vector<std::uint8_t> frame;
+  if (options.render) {
+    composer = std::make_unique<FrameComposer>(env);
+    frame.resize(FrameComposer::kHeight * FrameComposer::kWidth * 3);
+  }
+  const double step_seconds = m->opt.timestep * config.frame_skip;
+  const double fps = options.video_fps > 0 ? options.video_fps : 1.0 / step_seconds;
+
+  std::vector<double> action(env.action_space().size());
+  std::vector<double> first_gaze;
+  for (int i = 0; i < options.episodes; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    env.reset(options.seed + static_cast<std::uint64_t>(i));
+    Trajectory traj;
+    traj.qpos.reserve(static_cast<size_t>(options.duration) * m->nq);
+    std::optional<VideoWriter> video;
+    if (options.render) {
+      video.emplace(dir / "videos" / ("episode_" + std::to_string(i) + options.video_extension),
+                    FrameComposer::kWidth, FrameComposer::kHeight, fps);
+    }
+    for (int t = 0; t < options.duration; ++t) {
+      policy(env, action);
+      env.step(action);
+      traj.qpos.insert(traj.qpos.end(), env.data()->qpos, env.data()->qpos + m->nq);
+      traj.actions.insert(traj.actions.end(), action.begin(), action.end());
+      traj.infos.push_back(env.info().to_json(config.behavior).dump());
+      if (hand_regard) {
+        for (int eye = 0; eye < 2; ++eye) {
+          for (int hand = 0; hand < 2; ++hand) {
+            traj.gaze_angles.push_back(hand_regard->gaze_angle(env.data(), eye, hand));
+          }
+        }
+      }
+      if (video) {
+        composer->compose(env, frame);
+        video->write(frame);
+      }
+    }
+    if (video) video->close();
+    write_trajectory(traj, options.duration, m->nq, static_cast<int>(action.size()),
+                     dir / "trajectories" / ("episode_" + std::to_string(i) + ".npz"));
+    if (i == 0) first_gaze = traj.gaze_angles;
+
+    EpisodeResult result;
+    result.steps = options.duration;
+    result.score = envs::episode_score(config.behavior, env.info(), options.duration);
+    result.right_hand_touches = env.info().right_hand_touches;
+    result.left_hand_touches = env.info().left_hand_touches;
+    if (hand_regard) {
+      nlohmann::json entry = env.info().to_json(config.behavior);
+      entry["steps"] = options.duration;
+      result.hand_regard = hand_regard_episode_score(entry);
+    }
+    result.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!options.quiet) {
+      std::printf("episode %d: score %.4f (%.1f s)\n", i, result.score, result.wall_seconds);
+    }
+    report.episodes.push_back(std::move(result));
+  }
+
+  // Mean and standard deviation of the episode scores.
+  double sum = 0, sq = 0;
+  for (const EpisodeResult& e : report.episodes) sum += e.score;
+  report.mean = sum / options.episodes;
+  for (const EpisodeResult& e : report.episodes)
+    sq += (e.score - report.mean) * (e.score - report.mean);
+  report.std = std::sqrt(sq / options.episodes);
+
+  // Plots.
+  if (!log.empty()) plot_training_log(config.behavior, log, dir / "plots" / "training_score.png");
+  if (config.behavior == Behavior::kSelfTouch) {
+    plot_coverage(m, report.episodes, dir / "plots" / "touch_coverage.png");
+  }
+  if (hand_regard) {
+    plot_gaze(first_gaze, config.hand_regard_half_angle, dir / "plots" / "gaze_hand_angle.png");
+  }
+
+  // evaluation.json: every score, the config, the seed and versions.
+  nlohmann::json out = report.to_json();
+  out["config"] = to_json(config);
+  out["seed"] = options.seed;
+  out["episodes_requested"] = options.episodes;
+  out["duration"] = options.duration;
+  out["versions"] = {{"cradle", CRADLE_VERSION}, {"mujoco", mj_versionString()}};
+  std::ofstream file(dir / "evaluation.json");
+  file << out.dump(2) << "\n";
+  if (!file) throw UserError("cannot write '" + (dir / "evaluation.json").string() + "'");
+  return report;
+}
+
+nlohmann::json EvaluationReport::to_json() const {
+  nlohmann::json j;
+  j["training_log"] = {{"episodes", training_episodes}};
+  if (training_score) j["training_log"]["score"] = *training_score;
+  if (training_hand_regard) {
+    j["training_log"]["hand_regard_reference"] = training_hand_regard->reference;
+    j["training_log"]["hand_regard_either"] = training_hand_regard->either;
+  }
+  nlohmann::json list = nlohmann::json::array();
+  for (const EpisodeResult& e : episodes) {
+    nlohmann::json x = {{"steps", e.steps}, {"wall_seconds", e.wall_seconds}};
+    if (!std::isnan(e.score)) x["score"] = e.score;
+    if (e.hand_regard) {
+      x["hand_regard_reference"] = e.hand_regard->reference;
+      x["hand_regard_either"] = e.hand_regard->either;
+    }
+    if (!e.right_hand_touches.empty() || !e.left_hand_touches.empty()) {
+      x["right_hand_touches"] = e.right_hand_touches;
+      x["left_hand_touches"] = e.left_hand_touches;
+    }
+    list.push_back(std::move(x));
+  }
+  j["episodes"] = std::move(list);
+  if (!std::isnan(mean)) j["score"] = {{"mean", mean}, {"std", std}};
+  return j;
+}
+
+}  // namespace cradle::eval
