@@ -9,6 +9,7 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libstb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   zlib1g-dev
+  libtorch-dev libopenblas0-pthread
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   python3 python3-numpy
 )

@@ -11,5 +11,6 @@ void register_bench(CLI::App& app);
 void register_random(CLI::App& app);
 void register_evaluate(CLI::App& app);
 void register_test_installation(CLI::App& app);
+void register_train(CLI::App& app);
 
 }  // namespace cradle::apps

@@ -7,45 +7,54 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "eval/evaluation.h"
+#include "learn/trainer.h"
 
 namespace cradle::apps {
 
 void register_evaluate(CLI::App& app) {
   struct Options {
     std::string config;
+    std::string save_dir;
     int episodes = 10;
     int duration = 1000;
     bool render = true;
     std::uint64_t seed = 0;
     std::string format = "mp4";
+    std::string policy;
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "evaluate",
-      "Score the training log, then run evaluation episodes (random policy) and write "
+      "Score the training log, then run evaluation episodes (random or trained policy) and write "
       "trajectories, videos, evaluation.json and plots under save_dir.\n"
       "Scores: self-touch = (|geoms touched by right hand| + |by left hand|) / 68, unions over "
       "the last <= 10,000 logged episodes; hand regard = mean over the 4 eye-hand pairs of the "
       "fraction of steps in view (reference), and the mean over the eyes of the fraction with "
       "either hand in view (competition site).");
   cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--episodes", opts->episodes, "Evaluation episodes")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--duration", opts->duration, "Env steps per episode")
       ->check(CLI::Range(1, 100000000));
   cmd->add_flag("--render,!--no-render", opts->render, "Write a video per episode (default on)");
   cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i");
+  cmd->add_option("--policy", opts->policy,
+                  "Checkpoint of a trained policy (cradle train); default: random actions");
   cmd->add_option("--video-format", opts->format, "Video container")
       ->check(CLI::IsMember({"mp4", "avi"}));
   cmd->callback([opts] {
-    const Config config = load_config(opts->config);
+    Config config = load_config(opts->config);
+    if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     eval::EvaluationOptions options{.episodes = opts->episodes,
                                     .duration = opts->duration,
                                     .render = opts->render,
                                     .seed = opts->seed,
                                     .video_extension = "." + opts->format};
     const std::string behavior(behavior_name(config.behavior));
-    const eval::EvaluationReport r = eval::evaluate(config, options);
+    const eval::Policy policy =
+        opts->policy.empty() ? nullptr : learn::load_policy(config, opts->policy);
+    const eval::EvaluationReport r = eval::evaluate(config, options, policy);
     if (r.training_score) {
       std::printf("training log: %d entries, score %.4f\n", r.training_episodes, *r.training_score);
     } else {

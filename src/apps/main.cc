@@ -1,5 +1,7 @@
 // `cradle`: the command-line entry point. User errors print one line and exit 1; nothing a user
 // types may crash the program.
+#include <dlfcn.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +15,14 @@ int main(int argc, char** argv) {
   // slow rendering down, most of all when several envs render in parallel. A user's own
   // setting wins. Mesa reads it once, so it is set before any GL context exists.
   setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+  // Likewise OpenBLAS (under LibTorch): its threads slow the small networks by ~30% while the env
+  // workers keep the cores busy. It reads its variable when loaded, so it is told directly.
+  if (!std::getenv("OPENBLAS_NUM_THREADS")) {
+    using SetThreads = void (*)(int);
+    if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
+      set(1);
+    }
+  }
   CLI::App app{"Cradle: the BabyBench infant benchmark (MIMo in MuJoCo), in C++."};
   app.set_version_flag("--version", CRADLE_VERSION);
   app.require_subcommand(1);
@@ -22,6 +32,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_random(app);
   cradle::apps::register_evaluate(app);
   cradle::apps::register_test_installation(app);
+  cradle::apps::register_train(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

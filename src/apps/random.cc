@@ -18,6 +18,7 @@ namespace cradle::apps {
 void register_random(CLI::App& app) {
   struct Options {
     std::string config;
+    std::string save_dir;
     long train_for = 10000;
     std::uint64_t seed = 0;
   };
@@ -25,11 +26,13 @@ void register_random(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("random", "Random-policy baseline in training mode (writes the log)");
   cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--train_for,--train-for", opts->train_for, "Env steps to run")
       ->check(CLI::Range(1L, 1000000000L));
   cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy");
   cmd->callback([opts] {
-    const Config config = load_config(opts->config);
+    Config config = load_config(opts->config);
+    if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     auto env = envs::make_env(config, /*training=*/true, opts->seed);
     // The reference examples reset twice before training; one reset is enough here (the log
     // then starts with one 0-step entry).

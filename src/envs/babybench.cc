@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <string_view>
 
 #include "core/error.h"
 
@@ -102,6 +103,15 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
   if (c.vestibular_active) vestibular_.emplace(m);
   if (c.vision_active) eyes_ = std::make_unique<senses::Eyes>(m, c.vision_resolution);
   random_action_.resize(action_space().size());
+  for (int j = 0; j < m->njnt; ++j) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (!name || !std::string_view(name).starts_with("robot:")) continue;
+    bool held = false;
+    for (int e = 0; e < m->neq; ++e) {
+      held = held || (m->eq_active[e] && m->eq_type[e] == mjEQ_JOINT && m->eq_obj1id[e] == j);
+    }
+    if (!held) free_joints_.push_back(j);
+  }
 
   sim_.restore(assets_->settled);
   observe();
@@ -150,6 +160,14 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
   if (seed) rng_.seed_with(*seed);
   sim_.reset();
   sim_.restore(assets_->settled);
+  if (randomize_start_) {
+    const mjModel* m = model();
+    mjData* d = sim_.data();
+    for (int j : free_joints_) {
+      d->qpos[m->jnt_qposadr[j]] = rng_.uniform(m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
+    }
+    mj_forward(m, d);
+  }
 
   // Random start: a few random actions drawn from the env's own (seeded) generator.
   const Box& space = action_space();

@@ -75,6 +75,9 @@ class BabyBenchEnv final : public Env {
   // Training mode: every reset records the episode that just ended (the first reset records a
   // 0-step entry, as the reference does); close() records the last, partial one.
   void attach_log(std::shared_ptr<TrainingLog> log) { log_ = std::move(log); }
+  // Random start postures: every reset draws each free MIMo joint (not held by an active joint
+  // equality) uniformly within its range before the random start actions.
+  void set_randomize_start(bool on) { randomize_start_ = on; }
   void close();
 
   const DictSpace& observation_space() const override { return observation_space_; }
@@ -116,6 +119,8 @@ class BabyBenchEnv final : public Env {
   Info info_;
   Rng rng_;
   std::vector<double> random_action_;
+  bool randomize_start_ = false;
+  std::vector<int> free_joints_;  // robot:* joints no active joint equality holds
   int steps_ = 0;
   Profile profile_;
 };

@@ -1,0 +1,85 @@
+// `cradle train --config FILE --algo ppo --intrinsic NAME[,NAME...] --steps N --envs K --seed S
+// [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/commands.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "learn/trainer.h"
+
+namespace cradle::apps {
+namespace {
+
+// The one piece of process state: set by SIGINT so training stops cleanly with a checkpoint.
+std::atomic<bool> interrupted{false};
+extern "C" void on_interrupt(int) { interrupted.store(true); }
+
+}  // namespace
+
+void register_train(CLI::App& app) {
+  struct Options {
+    std::string config;
+    std::string save_dir;
+    learn::TrainOptions train;
+    std::vector<std::string> hp;
+    bool no_eval = false;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("train", "Train a policy with intrinsic motivation");
+  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
+  cmd->add_option("--algo", opts->train.algorithm, "Learning algorithm")
+      ->check(CLI::IsMember({"ppo", "a2c", "sac", "td3", "ddpg"}));
+  cmd->add_option("--intrinsic", opts->train.intrinsic,
+                  "Intrinsic rewards, name[:weight],... ('' for none)");
+  cmd->add_option("--steps", opts->train.steps, "Env steps in total")
+      ->check(CLI::Range(1L, 100000000000L));
+  cmd->add_option("--envs", opts->train.envs, "Parallel envs")->check(CLI::Range(1, 1024));
+  cmd->add_option("--threads", opts->train.threads, "Worker threads (0: one per env, <= cores)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--seed", opts->train.seed, "Seed of everything");
+  cmd->add_flag("--resume", opts->train.resume, "Continue from <save_dir>/checkpoints/latest.ckpt");
+  cmd->add_flag("--randomize-start", opts->train.randomize_start,
+                "Random start postures within joint limits");
+  cmd->add_option("--checkpoint-every", opts->train.checkpoint_every,
+                  "Env steps between checkpoints")
+      ->check(CLI::Range(1L, 100000000000L));
+  cmd->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
+  cmd->add_option("--eval-episodes", opts->train.eval_episodes, "Evaluation episodes at the end")
+      ->check(CLI::Range(0, 100000));
+  cmd->add_flag(
+      "--no-eval-video", [opts](std::int64_t) { opts->train.eval_render = false; },
+      "Evaluate without writing videos");
+  cmd->callback([opts] {
+    Config config = load_config(opts->config);
+    if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
+    for (const std::string& kv : opts->hp) {
+      const size_t eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        throw UserError("--hp '" + kv + "': expected name=value");
+      }
+      opts->train.hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
+    }
+    std::signal(SIGINT, on_interrupt);
+    opts->train.stop = &interrupted;
+    const learn::TrainResult r = learn::train(config, opts->train);
+    std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
+                r.steps_per_second, interrupted ? " — interrupted" : "");
+    std::printf("checkpoint: %s\n", r.checkpoint.c_str());
+    if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
+    if (r.evaluation) {
+      std::printf("evaluation of the trained policy (%zu episodes): %.4f +- %.4f\n",
+                  r.evaluation->episodes.size(), r.evaluation->mean, r.evaluation->std);
+    }
+    std::printf(
+        "logs: %s/logs/{training.jsonl, progress.csv}; plots: %s/plots/; videos: %s/videos/\n",
+        config.save_dir.c_str(), config.save_dir.c_str(), config.save_dir.c_str());
+  });
+}
+
+}  // namespace cradle::apps

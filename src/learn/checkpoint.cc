@@ -1,0 +1,199 @@
+#include "learn/checkpoint.h"
+
+#include <sstream>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+
+namespace cradle::learn {
+namespace {
+
+std::string read_string(torch::serialize::InputArchive& archive, const std::string& key) {
+  c10::IValue value;
+  archive.read(key, value);
+  return value.toStringRef();
+}
+
+long read_int(torch::serialize::InputArchive& archive, const std::string& key) {
+  c10::IValue value;
+  archive.read(key, value);
+  return value.toInt();
+}
+
+// Reads the header of an already loaded archive.
+CheckpointInfo read_header(torch::serialize::InputArchive& archive,
+                           const std::filesystem::path& file) {
+  const long format = read_int(archive, "format");
+  if (format != kCheckpointFormat) {
+    throw UserError(file.string() + ": checkpoint format " + std::to_string(format) +
+                    ", this build reads format " + std::to_string(kCheckpointFormat));
+  }
+  return {.algorithm = read_string(archive, "algorithm"),
+          .config = read_string(archive, "config"),
+          .steps = read_int(archive, "steps")};
+}
+
+void load_archive(torch::serialize::InputArchive& archive, const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file)) {
+    throw UserError(file.string() + ": no such checkpoint file");
+  }
+  try {
+    archive.load_from(file.string());
+  } catch (const c10::Error& error) {
+    throw UserError(file.string() + ": not a Cradle checkpoint (" + error.what_without_backtrace() +
+                    ")");
+  }
+}
+
+}  // namespace
+
+void write_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
+                      const ArchiveWriter& write_body) {
+  torch::serialize::OutputArchive archive;
+  archive.write("format", c10::IValue(static_cast<int64_t>(kCheckpointFormat)));
+  archive.write("algorithm", c10::IValue(header.algorithm));
+  archive.write("config", c10::IValue(header.config));
+  archive.write("steps", c10::IValue(static_cast<int64_t>(header.steps)));
+  write_body(archive);
+
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::filesystem::path temp = file;
+  temp += ".tmp";
+  try {
+    archive.save_to(temp.string());
+  } catch (const c10::Error& error) {
+    throw UserError(temp.string() + ": cannot write checkpoint (" + error.what_without_backtrace() +
+                    ")");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, file, ec);
+  if (ec) throw UserError(file.string() + ": cannot write checkpoint (" + ec.message() + ")");
+}
+
+CheckpointInfo read_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
+                               const ArchiveReader& read_body) {
+  torch::serialize::InputArchive archive;
+  load_archive(archive, file);
+  try {
+    CheckpointInfo info = read_header(archive, file);
+    if (info.algorithm != algorithm) {
+      throw UserError(file.string() + ": a " + info.algorithm + " checkpoint, not " +
+                      std::string(algorithm));
+    }
+    try {
+      read_body(info, archive);
+    } catch (const UserError& error) {
+      throw UserError(file.string() + ": does not fit this learner (" + error.what() + ")");
+    }
+    return info;
+  } catch (const c10::Error& error) {
+    throw UserError(file.string() + ": does not fit this learner (" +
+                    error.what_without_backtrace() + ")");
+  }
+}
+
+CheckpointInfo read_checkpoint_info(const std::filesystem::path& file) {
+  torch::serialize::InputArchive archive;
+  load_archive(archive, file);
+  try {
+    return read_header(archive, file);
+  } catch (const c10::Error& error) {
+    throw UserError(file.string() + ": not a Cradle checkpoint (" + error.what_without_backtrace() +
+                    ")");
+  }
+}
+
+namespace {
+
+// Parameters and buffers under their names, each child module in a nested archive.
+void write_tensors(torch::serialize::OutputArchive& archive, const torch::nn::Module& module) {
+  for (const auto& parameter : module.named_parameters(/*recurse=*/false)) {
+    archive.write(parameter.key(), parameter.value());
+  }
+  for (const auto& buffer : module.named_buffers(/*recurse=*/false)) {
+    archive.write(buffer.key(), buffer.value(), /*is_buffer=*/true);
+  }
+  for (const auto& child : module.named_children()) {
+    torch::serialize::OutputArchive nested(archive.compilation_unit());
+    write_tensors(nested, *child.value());
+    archive.write(child.key(), nested);
+  }
+}
+
+// Reads what write_tensors wrote into (destination, stored) pairs, checking every shape.
+void stage_tensors(torch::serialize::InputArchive& archive, torch::nn::Module& module,
+                   const std::string& prefix,
+                   std::vector<std::pair<torch::Tensor, torch::Tensor>>& staged) {
+  auto stage = [&](const std::string& name, const torch::Tensor& destination, bool is_buffer) {
+    torch::Tensor stored;
+    archive.read(name, stored, is_buffer);
+    if (stored.sizes() != destination.sizes()) {
+      std::ostringstream message;
+      message << prefix << name << " has shape " << stored.sizes() << " in the checkpoint, "
+              << destination.sizes() << " in this network";
+      throw UserError(message.str());
+    }
+    staged.emplace_back(destination, stored);
+  };
+  for (const auto& parameter : module.named_parameters(/*recurse=*/false)) {
+    stage(parameter.key(), parameter.value(), false);
+  }
+  for (const auto& buffer : module.named_buffers(/*recurse=*/false)) {
+    stage(buffer.key(), buffer.value(), true);
+  }
+  for (const auto& child : module.named_children()) {
+    torch::serialize::InputArchive nested;
+    archive.read(child.key(), nested);
+    stage_tensors(nested, *child.value(), prefix + child.key() + ".", staged);
+  }
+}
+
+}  // namespace
+
+void write_module(torch::serialize::OutputArchive& archive, const std::string& key,
+                  const torch::nn::Module& module) {
+  torch::serialize::OutputArchive nested(archive.compilation_unit());
+  write_tensors(nested, module);
+  archive.write(key, nested);
+}
+
+void read_module(torch::serialize::InputArchive& archive, const std::string& key,
+                 torch::nn::Module& module) {
+  torch::serialize::InputArchive nested;
+  archive.read(key, nested);
+  std::vector<std::pair<torch::Tensor, torch::Tensor>> staged;
+  stage_tensors(nested, module, key + ".", staged);
+  // Every shape matched: copy in place (the tensors keep their storage).
+  torch::NoGradGuard no_grad;
+  for (auto& [destination, stored] : staged) destination.copy_(stored);
+}
+
+void write_optimizer(torch::serialize::OutputArchive& archive, const std::string& key,
+                     const torch::optim::Optimizer& optimizer) {
+  torch::serialize::OutputArchive nested(archive.compilation_unit());
+  optimizer.save(nested);
+  archive.write(key, nested);
+}
+
+void read_optimizer(torch::serialize::InputArchive& archive, const std::string& key,
+                    torch::optim::Optimizer& optimizer) {
+  torch::serialize::InputArchive nested;
+  archive.read(key, nested);
+  optimizer.load(nested);
+}
+
+void write_generator(torch::serialize::OutputArchive& archive, const std::string& key,
+                     const at::Generator& generator) {
+  archive.write(key, generator.get_state());
+}
+
+void read_generator(torch::serialize::InputArchive& archive, const std::string& key,
+                    at::Generator& generator) {
+  torch::Tensor state;
+  archive.read(key, state);
+  generator.set_state(state);
+}
+
+}  // namespace cradle::learn

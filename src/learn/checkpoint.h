@@ -1,0 +1,50 @@
+// Checkpoint files: one LibTorch archive holding a header (format version, algorithm, config
+// text, step counter) and whatever the learner adds (modules, optimisers, the observation
+// normaliser, random generators) under its own keys. Writes are atomic: the archive goes to
+// "<file>.tmp" in the same folder, which is then renamed over <file>, so a crash never leaves a
+// half-written checkpoint behind.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "learn/learner.h"
+
+namespace cradle::learn {
+
+inline constexpr long kCheckpointFormat = 1;
+
+using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
+// Reads the body; gets the header (e.g. to check the saved config against the learner's).
+using ArchiveReader =
+    std::function<void(const CheckpointInfo& header, torch::serialize::InputArchive&)>;
+
+// Writes the header and then calls `write_body`; creates the parent folder if needed.
+void write_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
+                      const ArchiveWriter& write_body);
+// Reads the header, checks the format and the algorithm (UserError on a mismatch), then calls
+// `read_body`. LibTorch errors (missing keys, shape mismatches) become UserErrors naming the file.
+CheckpointInfo read_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
+                               const ArchiveReader& read_body);
+
+// Nested archives for the parts. read_module checks every parameter's and buffer's shape before
+// copying any (UserError naming the first mismatch; the module is then unchanged) and copies
+// in place, so tensors keep their storage (PackedParameters stay packed).
+void write_module(torch::serialize::OutputArchive& archive, const std::string& key,
+                  const torch::nn::Module& module);
+void read_module(torch::serialize::InputArchive& archive, const std::string& key,
+                 torch::nn::Module& module);
+void write_optimizer(torch::serialize::OutputArchive& archive, const std::string& key,
+                     const torch::optim::Optimizer& optimizer);
+void read_optimizer(torch::serialize::InputArchive& archive, const std::string& key,
+                    torch::optim::Optimizer& optimizer);
+// A generator's full state, so sampling continues exactly where it stopped.
+void write_generator(torch::serialize::OutputArchive& archive, const std::string& key,
+                     const at::Generator& generator);
+void read_generator(torch::serialize::InputArchive& archive, const std::string& key,
+                    at::Generator& generator);
+
+}  // namespace cradle::learn

@@ -1,0 +1,169 @@
+#include "learn/intrinsic/body_part_novelty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/error.h"
+#include "envs/babybench.h"
+#include "envs/self_touch.h"
+
+namespace cradle::learn::intrinsic {
+namespace {
+
+std::filesystem::path state_file(const std::filesystem::path& dir) {
+  return dir / "intrinsic_body_part_novelty.json";
+}
+
+void add_count(std::vector<long>& counts, int geom) {
+  if (geom < 0) return;
+  if (geom >= static_cast<int>(counts.size())) counts.resize(geom + 1, 0);
+  ++counts[geom];
+}
+
+}  // namespace
+
+BodyPartNovelty::BodyPartNovelty(double scale, Options options)
+    : IntrinsicReward(scale), options_(options) {
+  if (!(options_.balance >= 0 && options_.balance <= 1)) {
+    throw UserError("body_part_novelty: balance must lie in [0, 1]");
+  }
+}
+
+double BodyPartNovelty::hand_weight(int hand) const {
+  const double own = distinct_[hand], other = distinct_[1 - hand];
+  return (1 - options_.balance) + options_.balance * 2 * (1 + other) / (2 + own + other);
+}
+
+void BodyPartNovelty::bind(const VecEnv& env) {
+  const int n = env.num_envs();
+  seen_.assign(n, {0, 0});
+  starts_.assign(n, true);
+  hand_of_geom_.clear();
+  is_mimo_.clear();
+  const auto* baby = n > 0 ? dynamic_cast<const envs::BabyBenchEnv*>(&env.env(0)) : nullptr;
+  if (baby && options_.onset_weight > 0) {
+    const mjModel* m = baby->model();
+    const envs::SelfTouch rule(m);  // the behaviour's own geom tables
+    hand_of_geom_.assign(m->ngeom, -1);
+    is_mimo_.assign(m->ngeom, 0);
+    for (int g : rule.mimo_geoms()) is_mimo_[g] = 1;
+    for (int h = 0; h < 2; ++h) {
+      for (int g : rule.hand_geoms(h)) hand_of_geom_[g] = h;
+    }
+    in_contact_.assign(2 * n, std::vector<std::uint8_t>(m->ngeom, 0));
+    now_.assign(2, std::vector<std::uint8_t>(m->ngeom, 0));
+  }
+}
+
+void BodyPartNovelty::start_episode(int i) {
+  seen_[i] = {0, 0};
+  if (hand_of_geom_.empty()) return;
+  for (int h = 0; h < 2; ++h) {
+    std::fill(in_contact_[2 * i + h].begin(), in_contact_[2 * i + h].end(), 0);
+  }
+}
+
+void BodyPartNovelty::reset(const VecEnv& env) {
+  if (static_cast<int>(seen_.size()) != env.num_envs()) bind(env);
+  events_.clear();
+  for (int i = 0; i < env.num_envs(); ++i) {
+    start_episode(i);
+    if (!hand_of_geom_.empty()) collect_onsets(env, i);
+  }
+  events_.clear();  // contacts present at the start are no onsets
+  starts_.assign(env.num_envs(), false);
+}
+
+void BodyPartNovelty::collect_onsets(const VecEnv& env, int i) {
+  const auto& baby = dynamic_cast<const envs::BabyBenchEnv&>(env.env(i));
+  const mjData* d = baby.data();
+  for (auto& now : now_) std::fill(now.begin(), now.end(), 0);
+  // The self-touch rule: a hand geom against a MIMo geom that is not part of the same hand.
+  auto touch = [&](int hand_geom, int other) {
+    const int hand = hand_of_geom_[hand_geom];
+    if (hand < 0 || !is_mimo_[other] || hand_of_geom_[other] == hand) return;
+    now_[hand][other] = 1;
+  };
+  for (int c = 0; c < d->ncon; ++c) {
+    touch(d->contact[c].geom1, d->contact[c].geom2);
+    touch(d->contact[c].geom2, d->contact[c].geom1);
+  }
+  for (int h = 0; h < 2; ++h) {
+    std::vector<std::uint8_t>& before = in_contact_[2 * i + h];
+    for (size_t g = 0; g < before.size(); ++g) {
+      if (now_[h][g] && !before[g]) events_.push_back({h, static_cast<int>(g), true});
+    }
+    before.swap(now_[h]);
+  }
+}
+
+void BodyPartNovelty::compute(const VecEnv& env, std::span<const double>,
+                              std::span<double> rewards) {
+  if (static_cast<int>(seen_.size()) != env.num_envs()) bind(env);
+  events_.clear();
+  event_env_.clear();
+  for (int i = 0; i < env.num_envs(); ++i) {
+    const size_t before = events_.size();
+    if (starts_[i]) start_episode(i);
+    if (!hand_of_geom_.empty()) {
+      collect_onsets(env, i);
+      if (starts_[i]) events_.resize(before);  // a new episode's first contacts are no onsets
+    }
+    const envs::Info& info = env.info(i);
+    for (int h = 0; h < 2; ++h) {
+      const std::vector<int>& list = h == 0 ? info.right_hand_touches : info.left_hand_touches;
+      if (list.size() < seen_[i][h]) seen_[i][h] = 0;  // reset behind our back
+      for (size_t k = seen_[i][h]; k < list.size(); ++k) events_.push_back({h, list[k], false});
+      seen_[i][h] = list.size();
+    }
+    event_env_.resize(events_.size(), i);
+  }
+
+  // Bonuses from the counts before this step ...
+  const double weight[2] = {hand_weight(0), hand_weight(1)};
+  for (size_t e = 0; e < events_.size(); ++e) {
+    const Event& event = events_[e];
+    const double bonus =
+        event.onset ? options_.onset_weight / std::sqrt(1.0 + count(onset_[event.hand], event.geom))
+                    : 1.0 / std::sqrt(1.0 + count(first_[event.hand], event.geom));
+    rewards[event_env_[e]] += scale() * weight[event.hand] * bonus;
+  }
+  // ... then the counts take this step in.
+  for (const Event& event : events_) {
+    if (event.onset) {
+      add_count(onset_[event.hand], event.geom);
+    } else {
+      add_count(first_[event.hand], event.geom);
+      if (first_[event.hand][event.geom] == 1) ++distinct_[event.hand];
+    }
+  }
+  starts_.record_flags(env);
+}
+
+void BodyPartNovelty::save(const std::filesystem::path& dir) const {
+  const nlohmann::json state = {{"first", first_}, {"onset", onset_}};
+  std::ofstream out(state_file(dir));
+  out << state.dump() << "\n";
+  if (!out) throw UserError("cannot write " + state_file(dir).string());
+}
+
+void BodyPartNovelty::load(const std::filesystem::path& dir) {
+  std::ifstream in(state_file(dir));
+  if (!in) throw UserError("cannot read " + state_file(dir).string());
+  try {
+    const nlohmann::json state = nlohmann::json::parse(in);
+    state.at("first").get_to(first_);
+    state.at("onset").get_to(onset_);
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError("malformed " + state_file(dir).string() + ": " + e.what());
+  }
+  for (int h = 0; h < 2; ++h) {
+    distinct_[h] = 0;
+    for (long n : first_[h]) distinct_[h] += n > 0;
+  }
+}
+
+}  // namespace cradle::learn::intrinsic

@@ -1,0 +1,45 @@
+#include "learn/intrinsic/icm.h"
+
+namespace cradle::learn::intrinsic {
+
+void Icm::build(int features, int actions, at::Generator& gen) {
+  forward_ = make_mlp(features + actions, options().hidden, features, gen);
+  optimizer_ = std::make_unique<torch::optim::Adam>(
+      forward_->parameters(), torch::optim::AdamOptions(options().learning_rate));
+}
+
+torch::Tensor Icm::predict(const torch::Tensor& s, const torch::Tensor& a) {
+  return s + forward_->forward(torch::cat({s, a}, 1));
+}
+
+torch::Tensor Icm::score(const torch::Tensor& s, const torch::Tensor& a,
+                         const torch::Tensor& next) {
+  return (predict(s, a) - next).pow(2).mean(1);
+}
+
+double Icm::train_step(const std::function<Batch()>& draw) {
+  const Batch b = draw();
+  torch::Tensor loss = torch::mse_loss(predict(b.s, b.a), b.next);
+  optimizer_->zero_grad();
+  loss.backward();
+  optimizer_->step();
+  return loss.item<double>();
+}
+
+void Icm::save_models(torch::serialize::OutputArchive& archive) const {
+  torch::serialize::OutputArchive model, optimizer;
+  forward_->save(model);
+  optimizer_->save(optimizer);
+  archive.write("forward", model);
+  archive.write("optimizer", optimizer);
+}
+
+void Icm::load_models(torch::serialize::InputArchive& archive) {
+  torch::serialize::InputArchive model, optimizer;
+  archive.read("forward", model);
+  archive.read("optimizer", optimizer);
+  forward_->load(model);
+  optimizer_->load(optimizer);
+}
+
+}  // namespace cradle::learn::intrinsic

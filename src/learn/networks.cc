@@ -1,0 +1,211 @@
+#include "learn/networks.h"
+
+#include <dlfcn.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace cradle::learn {
+
+void PolicyConfig::bind(Hyperparameters& table) {
+  table.add("pi_layers", &pi_layers, "policy MLP hidden sizes, e.g. 64,64 (SB3 net_arch pi)");
+  table.add("vf_layers", &vf_layers, "value MLP hidden sizes, e.g. 64,64 (SB3 net_arch vf)");
+  table.add("activation", &activation, "hidden activation: tanh or relu (SB3 activation_fn)");
+  table.add("cnn_features", &cnn_features, "NatureCNN output size per image (SB3 features_dim)");
+  table.add("ortho_init", &ortho_init, "orthogonal initialisation (SB3 ortho_init)");
+  table.add("log_std_init", &log_std_init, "initial log std of the Gaussian (SB3 log_std_init)");
+}
+
+void apply_torch_options(const LearnerOptions& options) {
+  if (options.device != "cpu") {
+    throw UserError("device '" + options.device + "': this build trains on the cpu only");
+  }
+  if (options.torch_threads <= 0) return;
+  torch::set_num_threads(options.torch_threads);
+  // Debian's LibTorch does its matrix products in OpenBLAS, whose own thread pool LibTorch's
+  // setting does not reach: its workers would spin on the cores the envs step on.
+  using SetThreads = void (*)(int);
+  if (auto* set_threads =
+          reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
+    set_threads(options.torch_threads);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Initialisation
+
+void orthogonal_(torch::Tensor weight, double gain, at::Generator& generator) {
+  torch::NoGradGuard no_grad;
+  const long rows = weight.size(0);
+  const long cols = weight.numel() / rows;
+  torch::Tensor matrix = torch::randn({rows, cols}, generator, torch::kFloat32);
+  if (rows < cols) matrix = matrix.t();
+  auto [q, r] = torch::linalg::qr(matrix, "reduced");
+  q = q * torch::sign(torch::diagonal(r));  // makes the factorisation unique (uniform Haar)
+  if (rows < cols) q = q.t();
+  weight.copy_(q.reshape(weight.sizes()) * gain);
+}
+
+void init_layers(torch::nn::Module& module, double gain, bool orthogonal,
+                 at::Generator& generator) {
+  torch::NoGradGuard no_grad;
+  auto init = [&](torch::Tensor& weight, torch::Tensor& bias) {
+    const double fan_in = static_cast<double>(weight.numel() / weight.size(0));
+    const double bound = 1.0 / std::sqrt(fan_in);
+    if (orthogonal) {
+      orthogonal_(weight, gain, generator);
+    } else {
+      weight.uniform_(-bound, bound, generator);
+    }
+    if (!bias.defined()) return;
+    if (orthogonal) {
+      bias.zero_();
+    } else {
+      bias.uniform_(-bound, bound, generator);
+    }
+  };
+  for (const auto& child : module.modules(/*include_self=*/true)) {
+    if (auto* linear = child->as<torch::nn::Linear>()) {
+      init(linear->weight, linear->bias);
+    } else if (auto* conv = child->as<torch::nn::Conv2d>()) {
+      init(conv->weight, conv->bias);
+    }
+  }
+}
+
+PackedParameters::PackedParameters(torch::nn::Module& module) {
+  long total = 0;
+  for (const torch::Tensor& p : module.parameters()) total += p.numel();
+  packed_ = torch::zeros({total}, torch::kFloat32);
+  grad_ = torch::zeros({total}, torch::kFloat32);
+  torch::NoGradGuard no_grad;
+  long offset = 0;
+  for (torch::Tensor& p : module.parameters()) {
+    const long n = p.numel();
+    torch::Tensor slot = packed_.detach().slice(0, offset, offset + n).view(p.sizes());
+    slot.copy_(p.detach());
+    p.set_data(slot);
+    // Autograd accumulates into an existing gradient in place, i.e. into grad_.
+    p.mutable_grad() = grad_.slice(0, offset, offset + n).view(p.sizes());
+    offset += n;
+  }
+  packed_.set_requires_grad(true);
+  packed_.mutable_grad() = grad_;
+}
+
+torch::nn::Sequential make_mlp(int input, const std::vector<int>& layers,
+                               const std::string& activation) {
+  if (activation != "tanh" && activation != "relu") {
+    throw UserError("activation '" + activation + "': expected tanh or relu");
+  }
+  torch::nn::Sequential mlp;
+  for (const int size : layers) {
+    if (size <= 0) throw UserError("hidden layer sizes must be positive");
+    mlp->push_back(torch::nn::Linear(input, size));
+    if (activation == "tanh") {
+      mlp->push_back(torch::nn::Tanh());
+    } else {
+      mlp->push_back(torch::nn::ReLU());
+    }
+    input = size;
+  }
+  return mlp;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Encoders
+
+namespace {
+int conv_output(int size, int kernel, int stride) { return (size - kernel) / stride + 1; }
+}  // namespace
+
+NatureCnnImpl::NatureCnnImpl(int height, int width, int channels, int features) {
+  namespace nn = torch::nn;
+  int h = conv_output(conv_output(conv_output(height, 8, 4), 4, 2), 3, 1);
+  int w = conv_output(conv_output(conv_output(width, 8, 4), 4, 2), 3, 1);
+  if (h < 1 || w < 1) {
+    throw UserError("images of " + std::to_string(height) + "x" + std::to_string(width) +
+                    " are too small for the NatureCNN encoder (at least 36x36)");
+  }
+  convs_ = register_module(
+      "convs", nn::Sequential(nn::Conv2d(nn::Conv2dOptions(channels, 32, 8).stride(4)), nn::ReLU(),
+                              nn::Conv2d(nn::Conv2dOptions(32, 64, 4).stride(2)), nn::ReLU(),
+                              nn::Conv2d(nn::Conv2dOptions(64, 64, 3).stride(1)), nn::ReLU(),
+                              nn::Flatten()));
+  linear_ = register_module("linear", nn::Linear(64 * h * w, features));
+}
+
+torch::Tensor NatureCnnImpl::forward(const torch::Tensor& images) {
+  const torch::Tensor x = images.permute({0, 3, 1, 2}).to(torch::kFloat32).div_(255.0);
+  return torch::relu(linear_(convs_->forward(x)));
+}
+
+MultiInputEncoderImpl::MultiInputEncoderImpl(const ObsShape& shape, int cnn_features) {
+  output_size_ = shape.vector_size;
+  for (size_t k = 0; k < shape.images.size(); ++k) {
+    const auto& [h, w, c] = shape.images[k];
+    cnns_.push_back(register_module("cnn" + std::to_string(k), NatureCnn(h, w, c, cnn_features)));
+    output_size_ += cnn_features;
+  }
+}
+
+torch::Tensor MultiInputEncoderImpl::forward(const ObsBatch& observation) {
+  if (cnns_.empty()) return observation.vector;
+  std::vector<torch::Tensor> parts{observation.vector};
+  for (size_t k = 0; k < cnns_.size(); ++k)
+    parts.push_back(cnns_[k]->forward(observation.images[k]));
+  return torch::cat(parts, 1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Actor-critic
+
+GaussianActorCriticImpl::GaussianActorCriticImpl(const ObsShape& shape, int action_size,
+                                                 const PolicyConfig& config,
+                                                 at::Generator& generator) {
+  encoder_ = register_module("encoder", MultiInputEncoder(shape, config.cnn_features));
+  const int features = encoder_->output_size();
+  pi_net_ = register_module("pi_net", make_mlp(features, config.pi_layers, config.activation));
+  vf_net_ = register_module("vf_net", make_mlp(features, config.vf_layers, config.activation));
+  const int pi_out = config.pi_layers.empty() ? features : config.pi_layers.back();
+  const int vf_out = config.vf_layers.empty() ? features : config.vf_layers.back();
+  action_mean_ = register_module("action_mean", torch::nn::Linear(pi_out, action_size));
+  value_head_ = register_module("value_head", torch::nn::Linear(vf_out, 1));
+  log_std_ = register_parameter("log_std", torch::full({action_size}, config.log_std_init));
+
+  // SB3's gains: sqrt(2) for the encoder and hidden layers, 0.01 for the action mean (a nearly
+  // state-independent first policy), 1 for the value.
+  const double hidden_gain = std::sqrt(2.0);
+  init_layers(*encoder_, hidden_gain, config.ortho_init, generator);
+  init_layers(*pi_net_, hidden_gain, config.ortho_init, generator);
+  init_layers(*vf_net_, hidden_gain, config.ortho_init, generator);
+  init_layers(*action_mean_, 0.01, config.ortho_init, generator);
+  init_layers(*value_head_, 1.0, config.ortho_init, generator);
+}
+
+GaussianActorCriticImpl::Output GaussianActorCriticImpl::forward(const ObsBatch& observation) {
+  const torch::Tensor features = encoder_->forward(observation);
+  return {action_mean_(pi_net_->forward(features)),
+          value_head_(vf_net_->forward(features)).squeeze(1)};
+}
+
+torch::Tensor GaussianActorCriticImpl::value(const ObsBatch& observation) {
+  return value_head_(vf_net_->forward(encoder_->forward(observation))).squeeze(1);
+}
+
+torch::Tensor GaussianActorCriticImpl::log_prob(const torch::Tensor& mean,
+                                                const torch::Tensor& actions) const {
+  // log N(a; mu, sigma) = -((a - mu) / sigma)^2 / 2 - log sigma - log(2 pi) / 2, per dimension.
+  const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
+  const torch::Tensor z = (actions - mean) * torch::exp(-log_std_);
+  return (-0.5 * z.square() - log_std_ - half_log_2pi).sum(1);
+}
+
+torch::Tensor GaussianActorCriticImpl::entropy() const {
+  // H = sum over dimensions of (1 + log(2 pi)) / 2 + log sigma.
+  return (0.5 + 0.5 * std::log(2.0 * std::numbers::pi) + log_std_).sum();
+}
+
+}  // namespace cradle::learn

@@ -1,0 +1,202 @@
+#include "learn/rollout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace cradle::learn {
+
+void compute_gae(int steps, int envs, std::span<const float> rewards, std::span<const float> values,
+                 std::span<const float> last_values, std::span<const std::uint8_t> terminated,
+                 std::span<const std::uint8_t> dones, double gamma, double gae_lambda,
+                 std::span<float> advantages, std::span<float> returns) {
+  for (int e = 0; e < envs; ++e) {
+    double next_advantage = 0;
+    for (int t = steps - 1; t >= 0; --t) {
+      const int row = t * envs + e;
+      const double next_value = t + 1 < steps ? values[row + envs] : last_values[e];
+      const double bootstrap = terminated[row] ? 0.0 : gamma * next_value;
+      const double delta = rewards[row] + bootstrap - values[row];
+      const double carry = dones[row] ? 0.0 : gamma * gae_lambda * next_advantage;
+      next_advantage = delta + carry;
+      advantages[row] = static_cast<float>(next_advantage);
+      returns[row] = static_cast<float>(next_advantage + values[row]);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Buffer
+
+RolloutBuffer::RolloutBuffer(int steps, int envs, const ObsShape& shape, int action_size)
+    : steps(steps), envs(envs) {
+  const long n = static_cast<long>(steps) * envs;
+  observations = ObsBatch::zeros(shape, n);
+  actions = torch::zeros({n, action_size}, torch::kFloat32);
+  log_probs = torch::zeros({n}, torch::kFloat32);
+  values = torch::zeros({n}, torch::kFloat32);
+  rewards = torch::zeros({n}, torch::kFloat32);
+  terminated = torch::zeros({n}, torch::kUInt8);
+  dones = torch::zeros({n}, torch::kUInt8);
+  valid = torch::zeros({n}, torch::kUInt8);
+  last_values = torch::zeros({envs}, torch::kFloat32);
+  advantages = torch::zeros({n}, torch::kFloat32);
+  returns = torch::zeros({n}, torch::kFloat32);
+}
+
+void RolloutBuffer::compute_returns_and_advantages(double gamma, double gae_lambda) {
+  const size_t n = rows();
+  auto floats = [](const torch::Tensor& t) {
+    return std::span<float>(t.data_ptr<float>(), static_cast<size_t>(t.numel()));
+  };
+  auto bytes = [n](const torch::Tensor& t) {
+    return std::span<const std::uint8_t>(t.data_ptr<std::uint8_t>(), n);
+  };
+  compute_gae(steps, envs, floats(rewards), floats(values), floats(last_values), bytes(terminated),
+              bytes(dones), gamma, gae_lambda, floats(advantages), floats(returns));
+}
+
+torch::Tensor RolloutBuffer::valid_rows() const { return torch::nonzero(valid).squeeze(1); }
+
+// ---------------------------------------------------------------------------------------------
+// Episode statistics
+
+void EpisodeStats::reset(int envs) {
+  returns_.assign(envs, 0.0);
+  lengths_.assign(envs, 0);
+  sum_return_ = sum_length_ = 0;
+  ended_ = 0;
+}
+
+void EpisodeStats::add(int env, double reward) {
+  returns_[env] += reward;
+  ++lengths_[env];
+}
+
+void EpisodeStats::end(int env) {
+  sum_return_ += returns_[env];
+  sum_length_ += lengths_[env];
+  ++ended_;
+  returns_[env] = 0;
+  lengths_[env] = 0;
+}
+
+EpisodeStats::Summary EpisodeStats::take() {
+  Summary summary{.episodes = ended_};
+  summary.mean_return =
+      ended_ > 0 ? sum_return_ / ended_ : std::numeric_limits<double>::quiet_NaN();
+  summary.mean_length =
+      ended_ > 0 ? sum_length_ / ended_ : std::numeric_limits<double>::quiet_NaN();
+  sum_return_ = sum_length_ = 0;
+  ended_ = 0;
+  return summary;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Collection
+
+void clip_actions(const torch::Tensor& samples, const Box& bounds, std::span<double> actions) {
+  const torch::Tensor contiguous = samples.contiguous();
+  const float* src = contiguous.data_ptr<float>();
+  const size_t size = bounds.low.size();
+  for (size_t k = 0; k < actions.size(); ++k) {
+    const size_t j = k % size;
+    actions[k] = std::clamp(static_cast<double>(src[k]), bounds.low[j], bounds.high[j]);
+  }
+}
+
+RolloutCollector::RolloutCollector(VecEnv& env, ObservationPipeline& pipeline,
+                                   RewardHook reward_hook)
+    : env_(env), pipeline_(pipeline), reward_hook_(std::move(reward_hook)) {
+  const int envs = env.num_envs();
+  const int action_size = env.action_space().size();
+  observation_ = ObsBatch::zeros(pipeline.shape(), envs);
+  noise_ = torch::zeros({envs, action_size}, torch::kFloat32);
+  actions_.resize(static_cast<size_t>(envs) * action_size);
+  rewards_.resize(envs);
+}
+
+void RolloutCollector::start(std::uint64_t seed) {
+  env_.reset(seed);
+  pending_.assign(env_.num_envs(), 0);
+  episodes_.reset(env_.num_envs());
+  pipeline_.process(env_, /*update_stats=*/true, observation_);
+}
+
+void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& generator,
+                               RolloutBuffer& buffer) {
+  torch::NoGradGuard no_grad;
+  const int envs = env_.num_envs();
+  const long action_size = buffer.actions.size(1);
+  const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
+  for (int t = 0; t < buffer.steps; ++t) {
+    const long row = static_cast<long>(t) * envs;
+    buffer.observations.assign(row, observation_);
+
+    // a = mu + sigma * eps, eps ~ N(0, I); log pi(a) = sum(-eps^2 / 2 - log sigma - log(2 pi) / 2).
+    const GaussianActorCriticImpl::Output out = policy->forward(observation_);
+    noise_.normal_(0.0, 1.0, generator);
+    const torch::Tensor actions = out.mean + torch::exp(policy->log_std()) * noise_;
+    const torch::Tensor log_probs =
+        (-0.5 * noise_.square() - policy->log_std() - half_log_2pi).sum(1);
+    std::memcpy(buffer.actions.data_ptr<float>() + row * action_size, actions.data_ptr<float>(),
+                sizeof(float) * envs * action_size);
+    std::memcpy(buffer.log_probs.data_ptr<float>() + row, log_probs.data_ptr<float>(),
+                sizeof(float) * envs);
+    std::memcpy(buffer.values.data_ptr<float>() + row, out.value.contiguous().data_ptr<float>(),
+                sizeof(float) * envs);
+
+    clip_actions(actions, env_.action_space(), actions_);
+    env_.step(actions_);
+    const std::span<const double> env_rewards = env_.rewards();
+    std::copy(env_rewards.begin(), env_rewards.end(), rewards_.begin());
+    if (reward_hook_) reward_hook_(env_, actions_, rewards_);
+
+    const std::span<const std::uint8_t> terminated = env_.terminated();
+    const std::span<const std::uint8_t> truncated = env_.truncated();
+    float* rewards = buffer.rewards.data_ptr<float>() + row;
+    std::uint8_t* terminal = buffer.terminated.data_ptr<std::uint8_t>() + row;
+    std::uint8_t* done = buffer.dones.data_ptr<std::uint8_t>() + row;
+    std::uint8_t* valid = buffer.valid.data_ptr<std::uint8_t>() + row;
+    for (int e = 0; e < envs; ++e) {
+      if (pending_[e]) {  // this step reset env e: no transition
+        rewards[e] = 0;
+        terminal[e] = done[e] = valid[e] = 0;
+        pending_[e] = 0;
+        continue;
+      }
+      rewards[e] = static_cast<float>(rewards_[e]);
+      terminal[e] = terminated[e];
+      done[e] = terminated[e] || truncated[e];
+      valid[e] = 1;
+      episodes_.add(e, rewards_[e]);
+      if (done[e]) {
+        episodes_.end(e);
+        pending_[e] = 1;
+      }
+    }
+    pipeline_.process(env_, /*update_stats=*/true, observation_);
+  }
+  buffer.last_values.copy_(policy->value(observation_));
+}
+
+void act_gaussian(ObservationPipeline& pipeline, GaussianActorCritic& policy,
+                  at::Generator& generator, const Box& bounds,
+                  const envs::ObservationBuffers& observation, ObsBatch& scratch,
+                  std::span<double> action, bool deterministic) {
+  torch::NoGradGuard no_grad;
+  pipeline.process(observation, scratch);
+  const GaussianActorCriticImpl::Output out = policy->forward(scratch);
+  torch::Tensor sample = out.mean;
+  if (!deterministic) {
+    sample = out.mean + torch::exp(policy->log_std()) *
+                            torch::randn(out.mean.sizes(), generator, torch::kFloat32);
+  }
+  clip_actions(sample, bounds, action);
+}
+
+}  // namespace cradle::learn

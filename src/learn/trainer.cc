@@ -1,0 +1,259 @@
+#include "learn/trainer.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <vector>
+
+#include "core/error.h"
+#include "core/jsonl.h"
+#include "envs/babybench.h"
+#include "eval/plot.h"
+#include "eval/scores.h"
+#include "learn/hyperparams.h"
+#include "learn/intrinsic/reward.h"
+#include "learn/vector_env.h"
+
+namespace cradle::learn {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Columns of logs/progress.csv, CleanRL's names.
+const char* const kColumns[] = {"global_step",
+                                "time",
+                                "charts/SPS",
+                                "charts/episodic_return",
+                                "charts/episodic_length",
+                                "behaviour/score",
+                                "losses/value_loss",
+                                "losses/policy_loss",
+                                "losses/entropy",
+                                "losses/approx_kl",
+                                "losses/clip_fraction",
+                                "losses/explained_variance",
+                                "charts/learning_rate"};
+
+std::string cell(double v) {
+  if (std::isnan(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+double loss(const TrainStats& s, const char* name) {
+  const auto it = s.losses.find(name);
+  return it == s.losses.end() ? std::nan("") : it->second;
+}
+
+std::string duration_text(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const long s = static_cast<long>(seconds);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  return buf;
+}
+
+// Learning curves from progress.csv's rows.
+void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& dir) {
+  auto series = [&](int column, const char* label, int color) {
+    eval::Series s{.label = label, .color = eval::default_color(color)};
+    for (const auto& r : rows) {
+      if (!std::isnan(r[column])) {
+        s.x.push_back(r[0]);
+        s.y.push_back(r[column]);
+      }
+    }
+    return s;
+  };
+  eval::write_png(eval::render_line_plot({.title = "Training: episodic return (env + intrinsic)",
+                                          .x_label = "env steps",
+                                          .y_label = "return",
+                                          .series = {series(3, "episodic return", 0)}}),
+                  dir / "learning_curve_return.png");
+  eval::write_png(eval::render_line_plot({.title = "Training: behaviour score per episode",
+                                          .x_label = "env steps",
+                                          .y_label = "score",
+                                          .series = {series(5, "behaviour score", 1)}}),
+                  dir / "learning_curve_score.png");
+}
+
+}  // namespace
+
+TrainResult train(const Config& config, const TrainOptions& options) {
+  if (options.steps < 1) throw UserError("--steps must be at least 1");
+  if (options.envs < 1) throw UserError("--envs must be at least 1");
+  if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
+  const fs::path dir = config.save_dir;
+  const fs::path checkpoints = dir / "checkpoints";
+  const fs::path latest = checkpoints / "latest.ckpt";
+  if (options.resume && !fs::exists(latest)) {
+    throw UserError("--resume: no checkpoint at '" + latest.string() + "'");
+  }
+
+  // A resumed run keeps its algorithm and hyperparameters; the env log and progress continue.
+  std::string algorithm = options.algorithm;
+  std::map<std::string, std::string> hyperparameters = options.hyperparameters;
+  if (options.resume) {
+    const CheckpointInfo info = read_checkpoint_info(latest);
+    algorithm = info.algorithm;
+    hyperparameters = parse_hyperparameter_text(info.config);
+  }
+
+  auto vec = make_babybench_vec_env(config, options.envs, options.threads, /*training=*/true,
+                                    options.seed);
+  if (options.randomize_start) {
+    for (int i = 0; i < vec->num_envs(); ++i) {
+      dynamic_cast<envs::BabyBenchEnv&>(vec->env(i)).set_randomize_start(true);
+    }
+  }
+  std::unique_ptr<intrinsic::Composite> reward;
+  if (!options.intrinsic.empty()) {
+    reward = intrinsic::parse_intrinsic(options.intrinsic);
+    reward->bind(*vec);
+    // No reset(): the learner resets the vector itself at the start of learn(), and a freshly
+    // bound reward has no previous observation to pair with the first step.
+  }
+
+  // Behaviour score of the episodes that end, seen at the step that ends them.
+  double score_sum = 0;
+  int score_count = 0;
+  LearnerOptions lo{.seed = options.seed, .hyperparameters = hyperparameters};
+  lo.reward_hook = [&](const VecEnv& env, std::span<const double> actions,
+                       std::span<double> rewards) {
+    if (reward) reward->compute(env, actions, rewards);
+    for (int i = 0; i < env.num_envs(); ++i) {
+      if (env.terminated()[i] || env.truncated()[i]) {
+        const envs::Info& info = env.info(i);
+        const double s = envs::episode_score(config.behavior, info, info.steps + 1);
+        if (!std::isnan(s)) {
+          score_sum += s;
+          ++score_count;
+        }
+      }
+    }
+  };
+  std::unique_ptr<Learner> learner = make_learner(algorithm, *vec, lo);
+  if (options.resume) {
+    learner->load(latest);
+    if (reward) reward->load(checkpoints);
+  }
+
+  std::error_code ec;
+  fs::create_directories(checkpoints, ec);
+  auto save_checkpoint = [&](const fs::path& file) {
+    learner->save(file);
+    if (reward) reward->save(checkpoints);
+  };
+
+  // progress.csv: appended on resume, new otherwise.
+  const fs::path csv_file = dir / "logs" / "progress.csv";
+  const bool append = options.resume && fs::exists(csv_file);
+  std::ofstream csv(csv_file, append ? std::ios::app : std::ios::trunc);
+  if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
+  if (!append) {
+    for (size_t c = 0; c < std::size(kColumns); ++c) csv << (c ? "," : "") << kColumns[c];
+    csv << "\n";
+  }
+  std::vector<std::vector<double>> rows;
+
+  const auto start = Clock::now();
+  long next_checkpoint =
+      (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
+  const long first_step = learner->steps();
+  double last_score = std::nan("");
+  learner->learn(options.steps, [&](const TrainStats& s) {
+    if (reward) reward->update();
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (score_count > 0) last_score = score_sum / score_count;
+    const double window_score = score_count > 0 ? score_sum / score_count : std::nan("");
+    score_sum = 0;
+    score_count = 0;
+    std::vector<double> row = {static_cast<double>(s.steps),
+                               elapsed,
+                               s.sps,
+                               s.episodic_return,
+                               s.episodic_length,
+                               window_score,
+                               loss(s, "value_loss"),
+                               loss(s, "policy_loss"),
+                               loss(s, "entropy"),
+                               loss(s, "approx_kl"),
+                               loss(s, "clip_fraction"),
+                               loss(s, "explained_variance"),
+                               loss(s, "learning_rate")};
+    for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
+    csv << "\n";
+    csv.flush();
+    rows.push_back(std::move(row));
+
+    if (s.steps >= next_checkpoint) {
+      save_checkpoint(checkpoints / ("step_" + std::to_string(s.steps) + ".ckpt"));
+      save_checkpoint(latest);
+      next_checkpoint = (s.steps / options.checkpoint_every + 1) * options.checkpoint_every;
+    }
+    if (options.progress_bar) {
+      const double done = static_cast<double>(s.steps) / options.steps;
+      const double rate = (s.steps - first_step) / std::max(elapsed, 1e-9);
+      const int width = 30;
+      const int filled = static_cast<int>(std::min(1.0, done) * width);
+      std::fprintf(stderr, "\r[%s%s] %ld/%ld steps  %.0f steps/s  ETA %s  return %s  score %s ",
+                   std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+                   s.steps, options.steps, rate,
+                   duration_text((options.steps - s.steps) / std::max(rate, 1e-9)).c_str(),
+                   cell(s.episodic_return).c_str(), cell(last_score).c_str());
+      std::fflush(stderr);
+    }
+    return !(options.stop && options.stop->load());
+  });
+  if (options.progress_bar) std::fprintf(stderr, "\n");
+
+  TrainResult result;
+  result.steps = learner->steps();
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.steps_per_second = (result.steps - first_step) / std::max(result.seconds, 1e-9);
+  save_checkpoint(latest);
+  result.checkpoint = checkpoints / "final.ckpt";
+  save_checkpoint(result.checkpoint);
+  for (int i = 0; i < vec->num_envs(); ++i) {
+    dynamic_cast<envs::BabyBenchEnv&>(vec->env(i)).close();
+  }
+  if (!rows.empty()) plot_curves(rows, dir / "plots");
+  const fs::path log = dir / "logs" / "training.jsonl";
+  if (fs::exists(log))
+    result.training_score = eval::training_score(config.behavior, read_jsonl(log));
+
+  // The trained policy's evaluation, acting deterministically.
+  if (options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
+    eval::EvaluationOptions eo{.episodes = options.eval_episodes,
+                               .duration = options.eval_duration,
+                               .render = options.eval_render,
+                               .seed = options.seed + 1000,
+                               .quiet = true};
+    Learner* l = learner.get();
+    result.evaluation =
+        eval::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
+          l->act(env.observation(), action, /*deterministic=*/true);
+        });
+  }
+  return result;
+}
+
+eval::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint) {
+  if (!fs::exists(checkpoint)) {
+    throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
+  }
+  const CheckpointInfo info = read_checkpoint_info(checkpoint);
+  // A one-env vector of the config gives the learner its spaces; it is kept alive by the policy.
+  std::shared_ptr<VecEnv> vec = make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
+  LearnerOptions lo{.hyperparameters = parse_hyperparameter_text(info.config)};
+  std::shared_ptr<Learner> learner = make_learner(info.algorithm, *vec, lo);
+  learner->load(checkpoint);
+  return [vec, learner](const envs::BabyBenchEnv& env, std::span<double> action) {
+    learner->act(env.observation(), action, /*deterministic=*/true);
+  };
+}
+
+}  // namespace cradle::learn

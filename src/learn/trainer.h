@@ -1,0 +1,54 @@
+// `cradle train`: a BabyBench config trained with one learner and intrinsic rewards on a vector
+// of envs. Writes the env training log, logs/progress.csv (CleanRL names), checkpoints
+// (checkpoints/step_<n>.ckpt, latest.ckpt) and, at the end, the evaluation of the trained policy
+// and learning-curve PNGs.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "core/config.h"
+#include "eval/evaluation.h"
+#include "learn/learner.h"
+
+namespace cradle::learn {
+
+struct TrainOptions {
+  std::string algorithm = "ppo";
+  std::string intrinsic = "body_part_novelty";  // "name[:weight],..."; empty: env reward only
+  long steps = 100000;                          // env steps in total (counting a resumed run)
+  int envs = 2;
+  int threads = 0;  // 0: one per env, at most the cores
+  std::uint64_t seed = 0;
+  bool resume = false;           // continue from <save_dir>/checkpoints/latest.ckpt
+  bool randomize_start = false;  // random start postures within joint limits
+  long checkpoint_every = 100000;
+  std::map<std::string, std::string> hyperparameters;  // overrides, by name
+  int eval_episodes = 2;                               // 0: no final evaluation
+  int eval_duration = 1000;
+  bool eval_render = true;
+  bool progress_bar = true;
+  // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+struct TrainResult {
+  long steps = 0;
+  double seconds = 0;
+  double steps_per_second = 0;
+  std::optional<double> training_score;  // from the env training log
+  std::optional<eval::EvaluationReport> evaluation;
+  std::filesystem::path checkpoint;
+};
+
+TrainResult train(const Config& config, const TrainOptions& options);
+
+// The policy of a checkpoint, for `cradle evaluate --policy` (deterministic actions).
+eval::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint);
+
+}  // namespace cradle::learn

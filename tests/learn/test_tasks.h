@@ -1,0 +1,160 @@
+// Small MuJoCo tasks for the learner tests, built inline (header-only so several test files can
+// include it).
+//
+// CartPole: an inverted pendulum, a hinged pole on a slider cart (1 m of track each way), pushed
+// by a motor on the cart. Reward 1 per step; the episode terminates when the pole leans more
+// than 0.2 rad or the state is not finite, and is truncated after max_steps. The observation is
+// {"observation": [cart x, pole angle, cart velocity, pole angular velocity]} (float64), plus an
+// optional 64x64x3 uint8 "eye" image (a pattern drawn from the state) to exercise the CNN path.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/rng.h"
+#include "envs/env.h"
+#include "learn/vector_env.h"
+
+namespace cradle::learn::testing {
+
+inline constexpr char kCartPoleXml[] = R"(
+<mujoco model="cartpole">
+  <option timestep="0.02" integrator="RK4"/>
+  <default>
+    <geom contype="0" conaffinity="0"/>
+  </default>
+  <worldbody>
+    <body name="cart">
+      <joint name="slider" type="slide" axis="1 0 0" range="-1 1" limited="true"/>
+      <geom type="box" size="0.1 0.1 0.05" mass="1"/>
+      <body name="pole">
+        <joint name="hinge" type="hinge" axis="0 1 0"/>
+        <geom type="capsule" fromto="0 0 0 0.001 0 0.6" size="0.05" mass="0.5"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="slider" gear="10" ctrlrange="-3 3" ctrllimited="true"/>
+  </actuator>
+</mujoco>
+)";
+
+// One compiled model shared by every CartPole (read-only after loading).
+inline std::shared_ptr<const mjModel> cartpole_model() {
+  char error[1000] = "";
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  mj_makeEmptyFileVFS(&vfs, "cartpole.xml", sizeof(kCartPoleXml));
+  const int file = mj_findFileVFS(&vfs, "cartpole.xml");
+  std::copy(kCartPoleXml, kCartPoleXml + sizeof(kCartPoleXml),
+            static_cast<char*>(vfs.filedata[file]));
+  mjModel* model = mj_loadXML("cartpole.xml", &vfs, error, sizeof(error));
+  mj_deleteVFS(&vfs);
+  if (model == nullptr) throw std::runtime_error(std::string("cartpole: ") + error);
+  return {model, mj_deleteModel};
+}
+
+class CartPole final : public envs::Env {
+ public:
+  static constexpr double kMaxAngle = 0.2;  // rad
+  static constexpr int kFrameSkip = 2;
+
+  CartPole(std::shared_ptr<const mjModel> model, int max_steps, bool with_image)
+      : model_(std::move(model)),
+        data_(mj_makeData(model_.get()), mj_deleteData),
+        space_(make_space(with_image)),
+        action_space_(Box::uniform({1}, DType::kFloat32, -3.0, 3.0)),
+        obs_(space_),
+        max_steps_(max_steps),
+        with_image_(with_image) {}
+
+  const DictSpace& observation_space() const override { return space_; }
+  const Box& action_space() const override { return action_space_; }
+  const envs::ObservationBuffers& observation() const override { return obs_; }
+  const envs::Info& info() const override { return info_; }
+
+  void reset(std::optional<std::uint64_t> seed) override {
+    if (seed) rng_.seed_with(*seed);
+    mj_resetData(model_.get(), data_.get());
+    for (int i = 0; i < 2; ++i) {
+      data_->qpos[i] = rng_.uniform(-0.01, 0.01);
+      data_->qvel[i] = rng_.uniform(-0.01, 0.01);
+    }
+    mj_forward(model_.get(), data_.get());
+    info_.steps = 0;
+    observe();
+  }
+
+  envs::StepResult step(std::span<const double> action) override {
+    data_->ctrl[0] = std::clamp(action[0], -3.0, 3.0);
+    for (int i = 0; i < kFrameSkip; ++i) mj_step(model_.get(), data_.get());
+    ++info_.steps;
+    observe();
+    const auto state = obs_.f64(0);
+    const bool finite =
+        std::all_of(state.begin(), state.end(), [](double v) { return std::isfinite(v); });
+    envs::StepResult result{.reward = 1.0};
+    result.terminated = !finite || std::fabs(data_->qpos[1]) > kMaxAngle;
+    result.truncated = !result.terminated && info_.steps >= max_steps_;
+    return result;
+  }
+
+ private:
+  static DictSpace make_space(bool with_image) {
+    DictSpace space;
+    space.entries.push_back({"observation", Box::unbounded({4}, DType::kFloat64)});
+    if (with_image)
+      space.entries.push_back({"eye", Box::uniform({64, 64, 3}, DType::kUInt8, 0, 255)});
+    return space;
+  }
+
+  void observe() {
+    const std::span<double> state = obs_.f64(0);
+    state[0] = data_->qpos[0];
+    state[1] = data_->qpos[1];
+    state[2] = data_->qvel[0];
+    state[3] = data_->qvel[1];
+    if (!with_image_) return;
+    // A vertical bar whose column follows the pole tip, on a gradient.
+    const std::span<std::uint8_t> image = obs_.u8(1);
+    const int column =
+        std::clamp(static_cast<int>(32 + 60 * (data_->qpos[0] + 0.6 * data_->qpos[1])), 0, 63);
+    for (int y = 0; y < 64; ++y) {
+      for (int x = 0; x < 64; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          image[(y * 64 + x) * 3 + c] =
+              static_cast<std::uint8_t>(std::abs(x - column) < 3 ? 255 : (x + y + 40 * c) % 128);
+        }
+      }
+    }
+  }
+
+  std::shared_ptr<const mjModel> model_;
+  std::unique_ptr<mjData, void (*)(mjData*)> data_;
+  DictSpace space_;
+  Box action_space_;
+  envs::ObservationBuffers obs_;
+  envs::Info info_;
+  Rng rng_;
+  int max_steps_;
+  bool with_image_;
+};
+
+// `envs` CartPoles stepped in the calling thread.
+inline std::unique_ptr<ThreadedVecEnv> make_cartpoles(int envs, int max_steps,
+                                                      bool with_image = false) {
+  const std::shared_ptr<const mjModel> model = cartpole_model();
+  std::vector<std::unique_ptr<envs::Env>> list;
+  for (int i = 0; i < envs; ++i)
+    list.push_back(std::make_unique<CartPole>(model, max_steps, with_image));
+  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+}
+
+}  // namespace cradle::learn::testing
