@@ -3,8 +3,11 @@ BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
 CONFIG ?= configs/config_selftouch.yml
-STEPS ?= 20000
+STEPS ?= 500000
+ENVS ?= 2
 EPISODES ?= 2
+INTRINSIC ?= body_part_novelty
+RESULTS ?= results/make_run
 
 .PHONY: all deps configure build run test install format clean
 
@@ -19,11 +22,13 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# The main job: installation test, a random-policy baseline on CONFIG, then its evaluation.
+# The main job: installation test, then PPO with intrinsic motivation on CONFIG for STEPS env
+# steps, its evaluation (scores, videos, plots) next to the random policy's on the same seeds.
 run: build
-	@$(BUILD_DIR)/cradle test-installation
-	@$(BUILD_DIR)/cradle random --config $(CONFIG) --train_for $(STEPS)
-	@$(BUILD_DIR)/cradle evaluate --config $(CONFIG) --episodes $(EPISODES)
+	@$(BUILD_DIR)/cradle test-installation --save-dir $(RESULTS)/test_installation
+	@$(BUILD_DIR)/cradle train --config $(CONFIG) --save-dir $(RESULTS)/trained --algo ppo \
+	  --intrinsic $(INTRINSIC) --steps $(STEPS) --envs $(ENVS) --eval-episodes $(EPISODES) \
+	  --compare-random
 
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

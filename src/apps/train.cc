@@ -52,6 +52,8 @@ void register_train(CLI::App& app) {
   cmd->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
   cmd->add_option("--eval-episodes", opts->train.eval_episodes, "Evaluation episodes at the end")
       ->check(CLI::Range(0, 100000));
+  cmd->add_flag("--compare-random", opts->train.compare_random,
+                "Also evaluate the random policy (same seeds) and print both scores");
   cmd->add_flag(
       "--no-eval-video", [opts](std::int64_t) { opts->train.eval_render = false; },
       "Evaluate without writing videos");
@@ -75,6 +77,13 @@ void register_train(CLI::App& app) {
     if (r.evaluation) {
       std::printf("evaluation of the trained policy (%zu episodes): %.4f +- %.4f\n",
                   r.evaluation->episodes.size(), r.evaluation->mean, r.evaluation->std);
+    }
+    if (r.random_evaluation) {
+      std::printf(
+          "evaluation of the random policy  (%zu episodes): %.4f +- %.4f  (trained / "
+          "random = %.2f)\n",
+          r.random_evaluation->episodes.size(), r.random_evaluation->mean, r.random_evaluation->std,
+          r.evaluation ? r.evaluation->mean / r.random_evaluation->mean : 0.0);
     }
     std::printf(
         "logs: %s/logs/{training.jsonl, progress.csv}; plots: %s/plots/; videos: %s/videos/\n",

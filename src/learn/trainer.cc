@@ -237,6 +237,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
         eval::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
           l->act(env.observation(), action, /*deterministic=*/true);
         });
+    if (options.compare_random) {
+      Config baseline = config;
+      baseline.save_dir = (dir / "random_baseline").string();
+      eo.render = false;
+      result.random_evaluation = eval::evaluate(baseline, eo);
+    }
   }
   return result;
 }

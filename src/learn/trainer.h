@@ -32,6 +32,9 @@ struct TrainOptions {
   int eval_episodes = 2;                               // 0: no final evaluation
   int eval_duration = 1000;
   bool eval_render = true;
+  // Also evaluate the random policy the same way (same seeds, no video) into
+  // <save_dir>/random_baseline, to report the two scores side by side.
+  bool compare_random = false;
   bool progress_bar = true;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
@@ -43,6 +46,7 @@ struct TrainResult {
   double steps_per_second = 0;
   std::optional<double> training_score;  // from the env training log
   std::optional<eval::EvaluationReport> evaluation;
+  std::optional<eval::EvaluationReport> random_evaluation;
   std::filesystem::path checkpoint;
 };
 
