@@ -1,6 +1,7 @@
-// Google Benchmark target for the threaded vector env: self-touch env steps per second for
-// N envs on N threads (items_per_second counts env steps, so linear scaling doubles it). CPU is
-// the whole process's: about N times one env's step when the threads do not slow each other.
+// Google Benchmark target for the threaded vector env: self-touch env steps per second for N envs
+// on T threads (items_per_second counts env steps, so linear scaling doubles it from 1/1 to 2/2).
+// CPU is the whole process's: about N times one env's step when the threads do not slow each
+// other down.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -14,9 +15,10 @@ namespace {
 
 void BM_VecEnvSelfTouch(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
   const Config config =
       load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
-  const auto vec = learn::make_babybench_vec_env(config, n, n, /*training=*/false, 0);
+  const auto vec = learn::make_babybench_vec_env(config, n, threads, /*training=*/false, 0);
   vec->reset(0);
   const Box& space = vec->action_space();
   const size_t dim = space.low.size();
@@ -31,12 +33,13 @@ void BM_VecEnvSelfTouch(benchmark::State& state) {
   size_t t = 0;
   for (auto _ : state) vec->step(actions[t++ % actions.size()]);
   state.SetItemsProcessed(state.iterations() * n);
-  state.counters["threads"] = vec->threads();
 }
 BENCHMARK(BM_VecEnvSelfTouch)
-    ->Arg(1)
-    ->Arg(2)
-    ->ArgName("envs")
+    ->ArgNames({"envs", "threads"})
+    ->Args({1, 1})
+    ->Args({2, 2})
+    ->Args({4, 2})
+    ->Args({8, 2})
     ->UseRealTime()
     ->MeasureProcessCPUTime();
 

@@ -1,6 +1,7 @@
 #include "learn/vector_env.h"
 
 #include <algorithm>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -17,8 +18,8 @@ int participants(int threads, size_t envs) {
   return std::clamp(threads, 1, std::max(1, static_cast<int>(envs)));
 }
 
-// Checks that envs are present and share one set of spaces; returns the vector unchanged.
-std::vector<std::unique_ptr<envs::Env>> checked(std::vector<std::unique_ptr<envs::Env>> envs) {
+// Checks that envs are present and share one set of spaces.
+void check_envs(const std::vector<std::unique_ptr<envs::Env>>& envs) {
   if (envs.empty()) throw std::invalid_argument("ThreadedVecEnv: no envs");
   for (size_t i = 0; i < envs.size(); ++i) {
     if (!envs[i]) throw std::invalid_argument("ThreadedVecEnv: env " + std::to_string(i) + " null");
@@ -28,20 +29,39 @@ std::vector<std::unique_ptr<envs::Env>> checked(std::vector<std::unique_ptr<envs
                                   " has spaces different from env 0's");
     }
   }
-  return envs;
 }
 
 }  // namespace
 
 ThreadedVecEnv::ThreadedVecEnv(std::vector<std::unique_ptr<envs::Env>> envs, int threads)
-    : envs_(checked(std::move(envs))),
-      pool_(participants(threads, envs_.size())),
-      action_size_(envs_[0]->action_space().size()),
-      seeds_(envs_.size()),
-      rewards_(envs_.size()),
-      terminated_(envs_.size()),
-      truncated_(envs_.size()),
-      ended_(envs_.size()) {}
+    : pool_(participants(threads, envs.size())) {
+  envs_ = std::move(envs);
+  start();
+}
+
+ThreadedVecEnv::ThreadedVecEnv(int num_envs, const EnvFactory& make, int threads)
+    : pool_(participants(threads, std::max(num_envs, 0))) {
+  // One at a time (factories and GL context creation need not be thread-safe), each env on the
+  // thread that will step it.
+  envs_.resize(std::max(num_envs, 0));
+  std::mutex one_at_a_time;
+  pool_.parallel_for(num_envs, [&](int i) {
+    std::lock_guard lock(one_at_a_time);
+    envs_[i] = make(i);
+  });
+  start();
+}
+
+void ThreadedVecEnv::start() {
+  check_envs(envs_);
+  const size_t n = envs_.size();
+  action_size_ = envs_[0]->action_space().size();
+  seeds_.resize(n);
+  rewards_.resize(n);
+  terminated_.resize(n);
+  truncated_.resize(n);
+  ended_.resize(n);
+}
 
 std::uint64_t ThreadedVecEnv::env_seed(std::uint64_t seed, int env) {
   Rng rng(seed);
@@ -132,14 +152,14 @@ std::unique_ptr<ThreadedVecEnv> make_babybench_vec_env(const Config& config, int
   // One compiled model for all; one training log shared by all (it is thread-safe).
   const auto assets = envs::make_assets(config);
   const std::shared_ptr<envs::TrainingLog> log = training ? envs::start_training(*assets) : nullptr;
-  std::vector<std::unique_ptr<envs::Env>> list;
-  list.reserve(num_envs);
-  for (int i = 0; i < num_envs; ++i) {
-    auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
-    if (log) env->attach_log(log);
-    list.push_back(std::move(env));
-  }
-  return std::make_unique<ThreadedVecEnv>(std::move(list), threads);
+  return std::make_unique<ThreadedVecEnv>(
+      num_envs,
+      [&](int i) {
+        auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
+        if (log) env->attach_log(log);
+        return env;
+      },
+      threads);
 }
 
 }  // namespace cradle::learn

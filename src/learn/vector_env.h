@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -23,6 +24,10 @@ class ThreadedVecEnv final : public VecEnv {
   // Takes ownership of the envs, which must all have the same spaces. `threads` participants
   // (<= 0: hardware concurrency; 1: run inline), never more than there are envs.
   ThreadedVecEnv(std::vector<std::unique_ptr<envs::Env>> envs, int threads);
+  // Builds env i with make(i) on the participant that will step it (one env at a time), so that
+  // each env's small allocations come from that thread's malloc arena, apart from other envs'.
+  using EnvFactory = std::function<std::unique_ptr<envs::Env>(int)>;
+  ThreadedVecEnv(int num_envs, const EnvFactory& make, int threads);
 
   // Seed of env i for a vector seed: the i-th derive() of Rng(seed).
   static std::uint64_t env_seed(std::uint64_t seed, int env);
@@ -53,16 +58,19 @@ class ThreadedVecEnv final : public VecEnv {
   void gather(int key_index, std::span<std::uint8_t> out) const;
 
  private:
+  void start();  // checks the envs and sizes the batch buffers
+
+  ThreadPool pool_;  // first: envs are built on it and destroyed before it
   std::vector<std::unique_ptr<envs::Env>> envs_;
-  ThreadPool pool_;
-  int action_size_;
+  int action_size_ = 0;
   std::vector<std::uint64_t> seeds_;
   std::vector<double> rewards_;
   std::vector<std::uint8_t> terminated_, truncated_;
   std::vector<std::uint8_t> ended_;  // episode ended in the last call: reset on the next step
 };
 
-// BabyBench envs sharing one set of assets (one compiled model). training = true prepares
+// BabyBench envs sharing one set of assets (one compiled model; each env still holds its own
+// mjData, about 300 MB with the reference scenes' njmax = 5000). training = true prepares
 // <save_dir> as envs::make_env does and attaches one shared training log to every env.
 std::unique_ptr<ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
                                                        int threads, bool training,
