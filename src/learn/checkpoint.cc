@@ -196,4 +196,34 @@ void read_generator(torch::serialize::InputArchive& archive, const std::string& 
   generator.set_state(state);
 }
 
+void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
+                            const torch::nn::Module& policy,
+                            const torch::optim::Optimizer& optimizer,
+                            const ObservationPipeline& pipeline, const at::Generator& generator) {
+  write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) {
+    write_module(archive, "policy", policy);
+    write_optimizer(archive, "optimizer", optimizer);
+    torch::serialize::OutputArchive normalizer(archive.compilation_unit());
+    pipeline.save(normalizer);
+    archive.write("normalizer", normalizer);
+    write_generator(archive, "generator", generator);
+  });
+}
+
+CheckpointInfo load_policy_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
+                                      const ObservationConfig& observation,
+                                      torch::nn::Module& policy, torch::optim::Optimizer& optimizer,
+                                      ObservationPipeline& pipeline, at::Generator& generator) {
+  return read_checkpoint(
+      file, algorithm, [&](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
+        observation.check_matches(header.config);
+        read_module(archive, "policy", policy);
+        read_optimizer(archive, "optimizer", optimizer);
+        torch::serialize::InputArchive normalizer;
+        archive.read("normalizer", normalizer);
+        pipeline.load(normalizer);
+        read_generator(archive, "generator", generator);
+      });
+}
+
 }  // namespace cradle::learn

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "learn/learner.h"
+#include "learn/preprocess.h"
 
 namespace cradle::learn {
 
@@ -46,5 +47,18 @@ void write_generator(torch::serialize::OutputArchive& archive, const std::string
                      const at::Generator& generator);
 void read_generator(torch::serialize::InputArchive& archive, const std::string& key,
                     at::Generator& generator);
+
+// The whole checkpoint of a policy-gradient learner (PPO, A2C): its policy, optimiser,
+// observation normaliser and generator under fixed keys.
+void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
+                            const torch::nn::Module& policy,
+                            const torch::optim::Optimizer& optimizer,
+                            const ObservationPipeline& pipeline, const at::Generator& generator);
+// Reads one back after checking its observation settings against `observation`; returns the
+// header (its step counter is the learner's).
+CheckpointInfo load_policy_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
+                                      const ObservationConfig& observation,
+                                      torch::nn::Module& policy, torch::optim::Optimizer& optimizer,
+                                      ObservationPipeline& pipeline, at::Generator& generator);
 
 }  // namespace cradle::learn

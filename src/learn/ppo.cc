@@ -133,29 +133,14 @@ class Ppo final : public Learner {
   }
 
   void save(const std::filesystem::path& file) const override {
-    write_checkpoint(file, {.algorithm = "ppo", .config = settings_.text, .steps = steps_},
-                     [this](torch::serialize::OutputArchive& archive) {
-                       write_module(archive, "policy", *policy_);
-                       write_optimizer(archive, "optimizer", optimizer_);
-                       torch::serialize::OutputArchive normalizer(archive.compilation_unit());
-                       pipeline_.save(normalizer);
-                       archive.write("normalizer", normalizer);
-                       write_generator(archive, "generator", generator_);
-                     });
+    save_policy_checkpoint(file, {.algorithm = "ppo", .config = settings_.text, .steps = steps_},
+                           *policy_, optimizer_, pipeline_, generator_);
   }
 
   void load(const std::filesystem::path& file) override {
-    const CheckpointInfo info = read_checkpoint(
-        file, "ppo", [this](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
-          settings_.observation.check_matches(header.config);
-          read_module(archive, "policy", *policy_);
-          read_optimizer(archive, "optimizer", optimizer_);
-          torch::serialize::InputArchive normalizer;
-          archive.read("normalizer", normalizer);
-          pipeline_.load(normalizer);
-          read_generator(archive, "generator", generator_);
-        });
-    steps_ = info.steps;
+    steps_ = load_policy_checkpoint(file, "ppo", settings_.observation, *policy_, optimizer_,
+                                    pipeline_, generator_)
+                 .steps;
   }
 
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
