@@ -11,7 +11,8 @@ packages=(
   zlib1g-dev
   libtorch-dev libopenblas0-pthread
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
-  python3 python3-numpy
+  python3 python3-numpy python3-dev pybind11-dev python3-pytest
+  ccache
 )
 
 missing=()
