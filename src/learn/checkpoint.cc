@@ -196,6 +196,20 @@ void read_generator(torch::serialize::InputArchive& archive, const std::string& 
   generator.set_state(state);
 }
 
+void write_normalizer(torch::serialize::OutputArchive& archive, const std::string& key,
+                      const ObservationPipeline& pipeline) {
+  torch::serialize::OutputArchive nested(archive.compilation_unit());
+  pipeline.save(nested);
+  archive.write(key, nested);
+}
+
+void read_normalizer(torch::serialize::InputArchive& archive, const std::string& key,
+                     ObservationPipeline& pipeline) {
+  torch::serialize::InputArchive nested;
+  archive.read(key, nested);
+  pipeline.load(nested);
+}
+
 void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
                             const torch::nn::Module& policy,
                             const torch::optim::Optimizer& optimizer,
@@ -203,9 +217,7 @@ void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointI
   write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) {
     write_module(archive, "policy", policy);
     write_optimizer(archive, "optimizer", optimizer);
-    torch::serialize::OutputArchive normalizer(archive.compilation_unit());
-    pipeline.save(normalizer);
-    archive.write("normalizer", normalizer);
+    write_normalizer(archive, "normalizer", pipeline);
     write_generator(archive, "generator", generator);
   });
 }
@@ -219,9 +231,7 @@ CheckpointInfo load_policy_checkpoint(const std::filesystem::path& file, std::st
         observation.check_matches(header.config);
         read_module(archive, "policy", policy);
         read_optimizer(archive, "optimizer", optimizer);
-        torch::serialize::InputArchive normalizer;
-        archive.read("normalizer", normalizer);
-        pipeline.load(normalizer);
+        read_normalizer(archive, "normalizer", pipeline);
         read_generator(archive, "generator", generator);
       });
 }

@@ -48,6 +48,12 @@ void write_generator(torch::serialize::OutputArchive& archive, const std::string
 void read_generator(torch::serialize::InputArchive& archive, const std::string& key,
                     at::Generator& generator);
 
+// The observation normaliser's statistics (ObservationPipeline::save / load) in a nested archive.
+void write_normalizer(torch::serialize::OutputArchive& archive, const std::string& key,
+                      const ObservationPipeline& pipeline);
+void read_normalizer(torch::serialize::InputArchive& archive, const std::string& key,
+                     ObservationPipeline& pipeline);
+
 // The whole checkpoint of a policy-gradient learner (PPO, A2C): its policy, optimiser,
 // observation normaliser and generator under fixed keys.
 void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,

@@ -27,7 +27,7 @@ class Touch;
 
 namespace cradle::learn {
 
-// Progress, reported after every rollout and its update.
+// Progress, reported after every rollout and its update (off-policy: every report_every steps).
 struct TrainStats {
   long steps = 0;    // env steps so far (vector steps x num_envs), counting earlier runs resumed
   double sps = 0;    // env steps per second in this learn() call (collection and update)
@@ -36,8 +36,10 @@ struct TrainStats {
   // the rewards the learner trained on: env reward plus whatever the reward hook added.
   double episodic_return = std::numeric_limits<double>::quiet_NaN();
   double episodic_length = std::numeric_limits<double>::quiet_NaN();
-  // Losses and diagnostics of the last update, by name ("policy_loss", "value_loss", "entropy",
-  // "approx_kl", "clip_fraction", "explained_variance", "learning_rate", "std", ...).
+  // Losses and diagnostics of the last update(s), by name: "policy_loss", "value_loss",
+  // "entropy", "approx_kl", "clip_fraction", "explained_variance", "learning_rate", "std", ...
+  // for PPO and A2C; "qf_loss", "qf1_loss", "qf1_values", "actor_loss", "alpha", "alpha_loss"
+  // (CleanRL's names), means over the updates since the last report, for SAC, TD3 and DDPG.
   std::map<std::string, double> losses;
 };
 
@@ -56,10 +58,12 @@ using RewardHook = std::function<void(const VecEnv& env, std::span<const double>
 struct LearnerOptions {
   std::uint64_t seed = 0;  // seeds network initialisation, action sampling, minibatches, resets
   // Overrides of the algorithm's hyperparameters by name, e.g. {"n_steps", "512"}; values are
-  // text, parsed strictly. Besides the algorithm's own (see PpoConfig, A2cConfig) every learner
-  // takes the observation settings (ObservationConfig: normalize_observations,
-  // clip_observations, pool_touch) and the network settings (PolicyConfig: pi_layers,
-  // vf_layers, activation, cnn_features, ortho_init, log_std_init).
+  // text, parsed strictly. Besides the algorithm's own (see PpoConfig, A2cConfig, SacConfig,
+  // Td3Config, OffPolicyConfig) every learner takes the observation settings
+  // (ObservationConfig: normalize_observations, clip_observations, pool_touch) and the network
+  // settings (PolicyConfig for PPO and A2C: pi_layers, vf_layers, activation, cnn_features,
+  // ortho_init, log_std_init; OffPolicyNetworkConfig for SAC, TD3 and DDPG: pi_layers,
+  // qf_layers, activation, cnn_features).
   std::map<std::string, std::string> hyperparameters;
   // The skin the "touch" observation comes from, for touch pooling. When null and env(0) of the
   // VecEnv is a BabyBenchEnv, its skin is used.
@@ -74,9 +78,11 @@ struct LearnerOptions {
 class Learner {
  public:
   virtual ~Learner() = default;
-  virtual std::string_view algorithm() const = 0;  // "ppo", "a2c", ...
+  virtual std::string_view algorithm() const = 0;  // "ppo", "a2c", "sac", "td3", "ddpg"
   // Trains until steps() >= total_steps (whole rollouts, so it may overshoot by less than one
-  // rollout), reporting after each update; stops early when on_progress returns false.
+  // rollout; off-policy learners: whole vector steps), reporting after each update (off-policy
+  // learners: every report_every vector steps and at the end); stops early when on_progress
+  // returns false.
   virtual void learn(long total_steps, const ProgressFn& on_progress) = 0;
   // Env steps trained on so far (restored by load).
   virtual long steps() const = 0;
@@ -98,8 +104,8 @@ class Learner {
   virtual std::string config_text() const = 0;
 };
 
-// Builds a learner by name ("ppo", "a2c"). Throws UserError for an unknown algorithm or
-// hyperparameter, a bad value, or an env the learner cannot handle.
+// Builds a learner by name ("ppo", "a2c", "sac", "td3", "ddpg"). Throws UserError for an unknown
+// algorithm or hyperparameter, a bad value, or an env the learner cannot handle.
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options);
 

@@ -216,7 +216,7 @@ void ObservationPipeline::raw_vector(const envs::ObservationBuffers& observation
   }
 }
 
-void ObservationPipeline::process(const VecEnv& env, bool update_stats, ObsBatch& out) {
+void ObservationPipeline::gather(const VecEnv& env, ObsBatch& out) {
   const int rows = env.num_envs();
   const int n = shape_.vector_size;
   raw_.resize(static_cast<size_t>(rows) * n);
@@ -228,7 +228,28 @@ void ObservationPipeline::process(const VecEnv& env, bool update_stats, ObsBatch
                   observation.u8(image_keys_[k]).data(), image_bytes_[k]);
     }
   }
-  finish(rows, update_stats, out);
+}
+
+void ObservationPipeline::process(const VecEnv& env, bool update_stats, ObsBatch& out) {
+  gather(env, out);
+  finish(env.num_envs(), update_stats, out);
+}
+
+void ObservationPipeline::process_raw(const VecEnv& env, bool update_stats, ObsBatch& out) {
+  gather(env, out);
+  const int rows = env.num_envs();
+  std::copy(raw_.begin(), raw_.end(), out.vector.data_ptr<float>());
+  if (update_stats && config_.normalize_observations) normalizer_.update(raw_, rows);
+}
+
+void ObservationPipeline::normalize(const torch::Tensor& raw, torch::Tensor& out) const {
+  if (!config_.normalize_observations) {
+    out.copy_(raw);
+    return;
+  }
+  const size_t count = static_cast<size_t>(raw.numel());
+  normalizer_.normalize({raw.data_ptr<float>(), count}, {out.data_ptr<float>(), count},
+                        config_.clip_observations);
 }
 
 void ObservationPipeline::process(const envs::ObservationBuffers& observation, ObsBatch& out) {

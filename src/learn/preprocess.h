@@ -131,6 +131,12 @@ class ObservationPipeline {
   void process(const VecEnv& env, bool update_stats, ObsBatch& out);
   // One observation into row 0 of `out`, without updating the statistics (acting, evaluation).
   void process(const envs::ObservationBuffers& observation, ObsBatch& out);
+  // As process(env, ...), but `out` gets the vectors before normalisation (replay buffers keep
+  // raw observations and normalise them when sampled, with the statistics of that time).
+  void process_raw(const VecEnv& env, bool update_stats, ObsBatch& out);
+  // Normalises raw vectors ([rows, vector_size] float32, contiguous) into `out` (same shape);
+  // a copy when normalisation is off.
+  void normalize(const torch::Tensor& raw, torch::Tensor& out) const;
   // The vector before normalisation (pooled touch included), for tests and intrinsic rewards.
   void raw_vector(const envs::ObservationBuffers& observation, std::span<float> out) const;
 
@@ -146,6 +152,7 @@ class ObservationPipeline {
     int size = 0;
     bool pooled = false;
   };
+  void gather(const VecEnv& env, ObsBatch& out);  // raw vectors into raw_, images into out
   void finish(int rows, bool update_stats, ObsBatch& out);
 
   ObservationConfig config_;

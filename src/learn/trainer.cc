@@ -34,7 +34,12 @@ const char* const kColumns[] = {"global_step",
                                 "losses/approx_kl",
                                 "losses/clip_fraction",
                                 "losses/explained_variance",
-                                "charts/learning_rate"};
+                                "charts/learning_rate",
+                                "losses/qf_loss",
+                                "losses/actor_loss",
+                                "losses/alpha",
+                                "losses/alpha_loss",
+                                "losses/qf1_values"};
 
 std::string cell(double v) {
   if (std::isnan(v)) return "";
@@ -183,7 +188,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                loss(s, "approx_kl"),
                                loss(s, "clip_fraction"),
                                loss(s, "explained_variance"),
-                               loss(s, "learning_rate")};
+                               loss(s, "learning_rate"),
+                               loss(s, "qf_loss"),
+                               loss(s, "actor_loss"),
+                               loss(s, "alpha"),
+                               loss(s, "alpha_loss"),
+                               loss(s, "qf1_values")};
     for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
     csv << "\n";
     csv.flush();

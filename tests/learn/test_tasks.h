@@ -6,6 +6,12 @@
 // than 0.2 rad or the state is not finite, and is truncated after max_steps. The observation is
 // {"observation": [cart x, pole angle, cart velocity, pole angular velocity]} (float64), plus an
 // optional 64x64x3 uint8 "eye" image (a pattern drawn from the state) to exercise the CNN path.
+//
+// Pendulum: a torque-driven pendulum to swing up and balance (Gymnasium's Pendulum-v1 dynamics
+// in MJCF: a 1 m, 1 kg rod hinged at one end, g = 10, torque in [-2, 2], 0.05 s per step).
+// Reward -(angle^2 + 0.1 velocity^2 + 0.001 torque^2) with the angle from upright in
+// [-pi, pi]; episodes start at a random angle and are truncated after max_steps (never
+// terminated). The observation is {"observation": [cos angle, sin angle, angular velocity]}.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -154,6 +160,111 @@ inline std::unique_ptr<ThreadedVecEnv> make_cartpoles(int envs, int max_steps,
   std::vector<std::unique_ptr<envs::Env>> list;
   for (int i = 0; i < envs; ++i)
     list.push_back(std::make_unique<CartPole>(model, max_steps, with_image));
+  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+}
+
+inline constexpr char kPendulumXml[] = R"(
+<mujoco model="pendulum">
+  <option timestep="0.01" gravity="0 0 -10" integrator="RK4"/>
+  <worldbody>
+    <body name="pole">
+      <joint name="hinge" type="hinge" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 0 0 1" size="0.02" contype="0" conaffinity="0"/>
+      <inertial pos="0 0 0.5" mass="1" diaginertia="0.083333 0.083333 0.0001"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor joint="hinge" gear="1" ctrlrange="-2 2" ctrllimited="true"/>
+  </actuator>
+</mujoco>
+)";
+
+// One compiled model shared by every Pendulum.
+inline std::shared_ptr<const mjModel> pendulum_model() {
+  char error[1000] = "";
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  mj_makeEmptyFileVFS(&vfs, "pendulum.xml", sizeof(kPendulumXml));
+  const int file = mj_findFileVFS(&vfs, "pendulum.xml");
+  std::copy(kPendulumXml, kPendulumXml + sizeof(kPendulumXml),
+            static_cast<char*>(vfs.filedata[file]));
+  mjModel* model = mj_loadXML("pendulum.xml", &vfs, error, sizeof(error));
+  mj_deleteVFS(&vfs);
+  if (model == nullptr) throw std::runtime_error(std::string("pendulum: ") + error);
+  return {model, mj_deleteModel};
+}
+
+class Pendulum final : public envs::Env {
+ public:
+  static constexpr int kFrameSkip = 5;  // 0.05 s per step
+  static constexpr double kMaxTorque = 2.0;
+
+  Pendulum(std::shared_ptr<const mjModel> model, int max_steps)
+      : model_(std::move(model)),
+        data_(mj_makeData(model_.get()), mj_deleteData),
+        space_(make_space()),
+        action_space_(Box::uniform({1}, DType::kFloat32, -kMaxTorque, kMaxTorque)),
+        obs_(space_),
+        max_steps_(max_steps) {}
+
+  const DictSpace& observation_space() const override { return space_; }
+  const Box& action_space() const override { return action_space_; }
+  const envs::ObservationBuffers& observation() const override { return obs_; }
+  const envs::Info& info() const override { return info_; }
+
+  void reset(std::optional<std::uint64_t> seed) override {
+    if (seed) rng_.seed_with(*seed);
+    mj_resetData(model_.get(), data_.get());
+    data_->qpos[0] = rng_.uniform(-M_PI, M_PI);
+    data_->qvel[0] = rng_.uniform(-1.0, 1.0);
+    mj_forward(model_.get(), data_.get());
+    info_.steps = 0;
+    observe();
+  }
+
+  envs::StepResult step(std::span<const double> action) override {
+    const double torque = std::clamp(action[0], -kMaxTorque, kMaxTorque);
+    const double angle = std::remainder(data_->qpos[0], 2 * M_PI);  // from upright, [-pi, pi]
+    const double velocity = data_->qvel[0];
+    data_->ctrl[0] = torque;
+    for (int i = 0; i < kFrameSkip; ++i) mj_step(model_.get(), data_.get());
+    ++info_.steps;
+    observe();
+    envs::StepResult result{
+        .reward = -(angle * angle + 0.1 * velocity * velocity + 0.001 * torque * torque)};
+    result.truncated = info_.steps >= max_steps_;
+    return result;
+  }
+
+ private:
+  static DictSpace make_space() {
+    DictSpace space;
+    space.entries.push_back({"observation", Box::unbounded({3}, DType::kFloat64)});
+    return space;
+  }
+
+  void observe() {
+    const std::span<double> state = obs_.f64(0);
+    state[0] = std::cos(data_->qpos[0]);
+    state[1] = std::sin(data_->qpos[0]);
+    state[2] = data_->qvel[0];
+  }
+
+  std::shared_ptr<const mjModel> model_;
+  std::unique_ptr<mjData, void (*)(mjData*)> data_;
+  DictSpace space_;
+  Box action_space_;
+  envs::ObservationBuffers obs_;
+  envs::Info info_;
+  Rng rng_;
+  int max_steps_;
+};
+
+// `envs` Pendulums stepped in the calling thread.
+inline std::unique_ptr<ThreadedVecEnv> make_pendulums(int envs, int max_steps) {
+  const std::shared_ptr<const mjModel> model = pendulum_model();
+  std::vector<std::unique_ptr<envs::Env>> list;
+  for (int i = 0; i < envs; ++i) list.push_back(std::make_unique<Pendulum>(model, max_steps));
   return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
 }
 

@@ -1,0 +1,230 @@
+#include "learn/off_policy.h"
+
+#include <chrono>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+#include "learn/checkpoint.h"
+
+namespace cradle::learn {
+
+void OffPolicyConfig::bind(Hyperparameters& table) {
+  table.add("learning_rate", &learning_rate, "Adam step size of every network");
+  table.add("buffer_size", &buffer_size, "replay buffer capacity in transitions");
+  table.add("learning_starts", &learning_starts, "transitions (random actions) before training");
+  table.add("batch_size", &batch_size, "minibatch size");
+  table.add("tau", &tau, "Polyak coefficient of the target networks");
+  table.add("gamma", &gamma, "discount factor");
+  table.add("train_freq", &train_freq, "vector steps between trainings");
+  table.add("gradient_steps", &gradient_steps, "gradient steps per training");
+  table.add("report_every", &report_every, "vector steps between progress reports");
+}
+
+void OffPolicyConfig::check(std::string_view algorithm) const {
+  const std::string name(algorithm);
+  if (batch_size < 1 || train_freq < 1 || gradient_steps < 1 || report_every < 1) {
+    throw UserError(name +
+                    ": batch_size, train_freq, gradient_steps and report_every must be positive");
+  }
+  if (learning_starts < 0) throw UserError(name + ": learning_starts must be >= 0");
+  if (!(tau > 0 && tau <= 1)) throw UserError(name + ": tau must be in (0, 1]");
+  if (!(gamma >= 0 && gamma <= 1)) throw UserError(name + ": gamma must be in [0, 1]");
+  if (!(learning_rate > 0)) throw UserError(name + ": learning_rate must be positive");
+}
+
+void OffPolicyNetworkConfig::bind(Hyperparameters& table) {
+  table.add("pi_layers", &pi_layers, "actor MLP hidden sizes, e.g. 256,256 (SB3 net_arch pi)");
+  table.add("qf_layers", &qf_layers, "critic MLP hidden sizes, e.g. 256,256 (SB3 net_arch qf)");
+  table.add("activation", &activation, "hidden activation: relu or tanh (SB3 activation_fn)");
+  table.add("cnn_features", &cnn_features, "NatureCNN output size per image (SB3 features_dim)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Critics
+
+CriticImpl::CriticImpl(const ObsShape& shape, int action_size, int critics,
+                       const OffPolicyNetworkConfig& config, at::Generator& generator) {
+  encoder_ = register_module("encoder", MultiInputEncoder(shape, config.cnn_features));
+  const int input = encoder_->output_size() + action_size;
+  const int last = config.qf_layers.empty() ? input : config.qf_layers.back();
+  for (int i = 0; i < critics; ++i) {
+    torch::nn::Sequential q = make_mlp(input, config.qf_layers, config.activation);
+    q->push_back(torch::nn::Linear(last, 1));
+    q_.push_back(register_module("q" + std::to_string(i + 1), q));
+  }
+  // SB3 keeps PyTorch's default initialisation for off-policy networks. (Per child: a module
+  // under construction cannot list itself.)
+  for (const auto& child : children()) init_layers(*child, 1.0, /*orthogonal=*/false, generator);
+}
+
+torch::Tensor CriticImpl::forward(const ObsBatch& observation, const torch::Tensor& actions) {
+  const torch::Tensor input = torch::cat({encoder_->forward(observation), actions}, 1);
+  std::vector<torch::Tensor> values;
+  for (auto& q : q_) values.push_back(q->forward(input).squeeze(1));
+  return torch::stack(values);
+}
+
+torch::Tensor CriticImpl::q1(const ObsBatch& observation, const torch::Tensor& actions) {
+  return q_[0]->forward(torch::cat({encoder_->forward(observation), actions}, 1)).squeeze(1);
+}
+
+void polyak_update(torch::Tensor& target, const torch::Tensor& online, double tau) {
+  torch::NoGradGuard no_grad;
+  target.mul_(1.0 - tau).add_(online, tau);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The learner skeleton
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The replay capacity, once the env's actions and the buffer's memory are known to be fine.
+long checked_capacity(std::string_view algorithm, const VecEnv& env, long capacity,
+                      const ObsShape& shape) {
+  check_bounded_actions(algorithm, env.action_space());
+  check_replay_memory(algorithm, capacity, shape, env.action_space().size());
+  return capacity;
+}
+
+}  // namespace
+
+OffPolicyLearner::OffPolicyLearner(std::string algorithm, VecEnv& env,
+                                   const LearnerOptions& options, const OffPolicyConfig& loop,
+                                   const ObservationConfig& observation, std::string text)
+    : algorithm_(std::move(algorithm)),
+      env_(env),
+      config_(loop),
+      observation_(observation),
+      text_(std::move(text)),
+      generator_(at::make_generator<at::CPUGeneratorImpl>(options.seed)),
+      pipeline_(env.observation_space(), observation_, find_touch(env, options.touch)),
+      buffer_(checked_capacity(algorithm_, env, config_.buffer_size, pipeline_.shape()),
+              pipeline_.shape(), env.action_space().size()),
+      collector_(env, pipeline_, options.reward_hook),
+      scratch_(ObsBatch::zeros(pipeline_.shape(), 1)) {}
+
+void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
+  const Clock::time_point start = Clock::now();
+  const long start_steps = steps_;
+  const int envs = env_.num_envs();
+  collector_.start(draw_seed());
+  torch::Tensor random = torch::zeros({envs, action_size()}, torch::kFloat32);
+  records_.clear();
+  while (steps_ < total_steps) {
+    // Act: uniformly at random until learning_starts, then the algorithm's exploration.
+    torch::Tensor actions;
+    if (steps_ < config_.learning_starts) {
+      actions = random.uniform_(-1.0, 1.0, generator_);
+    } else {
+      torch::NoGradGuard no_grad;
+      actions = policy_action(collector_.observation(), /*deterministic=*/false);
+    }
+    collector_.step(actions, buffer_);
+    steps_ += envs;
+    ++vector_steps_;
+
+    // Train every train_freq vector steps once the buffer holds more than learning_starts.
+    if (vector_steps_ % config_.train_freq == 0 && buffer_.size() > config_.learning_starts) {
+      for (int g = 0; g < config_.gradient_steps; ++g) {
+        ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
+        pipeline_.normalize(batch.observations.vector, batch.observations.vector);
+        pipeline_.normalize(batch.next_observations.vector, batch.next_observations.vector);
+        train(batch, ++updates_);
+      }
+    }
+
+    if (vector_steps_ % config_.report_every != 0 && steps_ < total_steps) continue;
+    TrainStats stats{.steps = steps_};
+    for (const auto& [name, record] : records_) stats.losses[name] = record.first / record.second;
+    records_.clear();
+    stats.losses["learning_rate"] = config_.learning_rate;
+    stats.losses["buffer_transitions"] = static_cast<double>(buffer_.size());
+    const EpisodeStats::Summary episodes = collector_.episodes().take();
+    stats.episodes = episodes.episodes;
+    stats.episodic_return = episodes.mean_return;
+    stats.episodic_length = episodes.mean_length;
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
+    if (on_progress && !on_progress(stats)) break;
+  }
+}
+
+void OffPolicyLearner::record(const std::string& name, double value) {
+  auto& [sum, count] = records_[name];
+  sum += value;
+  ++count;
+}
+
+void OffPolicyLearner::act(const envs::ObservationBuffers& observation, std::span<double> action,
+                           bool deterministic) {
+  torch::NoGradGuard no_grad;
+  pipeline_.process(observation, scratch_);
+  unscale_actions(policy_action(scratch_, deterministic), env_.action_space(), action);
+}
+
+std::uint64_t OffPolicyLearner::draw_seed() {
+  return static_cast<std::uint64_t>(
+      torch::randint(0, std::numeric_limits<int64_t>::max(), {1}, generator_).item<int64_t>());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checkpoints: the registered parts, the normaliser, the generator and the counters. The
+// replay buffer is not saved (it can take gigabytes): a resumed run refills it.
+
+void OffPolicyLearner::checkpoint_module(std::string key, torch::nn::Module& module) {
+  modules_.emplace_back(std::move(key), &module);
+}
+
+void OffPolicyLearner::checkpoint_optimizer(std::string key, torch::optim::Optimizer& optimizer) {
+  optimizers_.emplace_back(std::move(key), &optimizer);
+}
+
+void OffPolicyLearner::checkpoint_tensor(std::string key, torch::Tensor& tensor) {
+  tensors_.emplace_back(std::move(key), &tensor);
+}
+
+void OffPolicyLearner::save(const std::filesystem::path& file) const {
+  const CheckpointInfo header{.algorithm = algorithm_, .config = text_, .steps = steps_};
+  write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) {
+    for (const auto& [key, module] : modules_) write_module(archive, key, *module);
+    for (const auto& [key, optimizer] : optimizers_) write_optimizer(archive, key, *optimizer);
+    for (const auto& [key, tensor] : tensors_) archive.write(key, tensor->detach());
+    write_normalizer(archive, "normalizer", pipeline_);
+    write_generator(archive, "generator", generator_);
+    archive.write("counters", torch::tensor({vector_steps_, updates_}, torch::kInt64));
+  });
+}
+
+void OffPolicyLearner::load(const std::filesystem::path& file) {
+  const CheckpointInfo info = read_checkpoint(
+      file, algorithm_, [&](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
+        observation_.check_matches(header.config);
+        // Tensors first: their shapes are checked before anything changes.
+        std::vector<torch::Tensor> stored(tensors_.size());
+        for (size_t i = 0; i < tensors_.size(); ++i) {
+          archive.read(tensors_[i].first, stored[i]);
+          if (stored[i].sizes() != tensors_[i].second->sizes()) {
+            std::ostringstream message;
+            message << tensors_[i].first << " has shape " << stored[i].sizes()
+                    << " in the checkpoint, " << tensors_[i].second->sizes() << " here";
+            throw UserError(message.str());
+          }
+        }
+        for (const auto& [key, module] : modules_) read_module(archive, key, *module);
+        for (const auto& [key, optimizer] : optimizers_) read_optimizer(archive, key, *optimizer);
+        torch::NoGradGuard no_grad;
+        for (size_t i = 0; i < tensors_.size(); ++i) tensors_[i].second->copy_(stored[i]);
+        read_normalizer(archive, "normalizer", pipeline_);
+        read_generator(archive, "generator", generator_);
+        torch::Tensor counters;
+        archive.read("counters", counters);
+        vector_steps_ = counters[0].item<long>();
+        updates_ = counters[1].item<long>();
+      });
+  steps_ = info.steps;
+}
+
+}  // namespace cradle::learn

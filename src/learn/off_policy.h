@@ -1,0 +1,167 @@
+// What SAC, TD3 and DDPG share (SB3's OffPolicyAlgorithm): the settings of the replay loop,
+// the networks' sizes, the Q critics, Polyak averaging, and the learner skeleton that collects
+// transitions, trains every train_freq vector steps, reports, acts and checkpoints. Each
+// algorithm's file holds its actor and its update, the part the papers are about.
+//
+// The loop (SB3 semantics, counted in env steps = vector steps x num_envs):
+//   while steps < total_steps:
+//     a = uniform in [-1, 1] while steps < learning_starts, else the algorithm's exploration
+//     step the envs with a rescaled to the Box; store the real transitions
+//     every train_freq vector steps, once the buffer holds more than learning_starts
+//     transitions: gradient_steps updates on minibatches of batch_size
+//   reporting every report_every vector steps.
+// Training waits on the buffer's size rather than the step counter so that a resumed run,
+// whose buffer starts empty (it is not saved), refills it before training again; it acts
+// with its loaded policy meanwhile. A fresh run trains from the same step as SB3's.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "learn/hyperparams.h"
+#include "learn/learner.h"
+#include "learn/networks.h"
+#include "learn/preprocess.h"
+#include "learn/replay_buffer.h"
+
+namespace cradle::learn {
+
+// The replay loop's settings; each algorithm sets its SB3 defaults before binding.
+struct OffPolicyConfig {
+  double learning_rate = 3e-4;   // Adam step size of every network (and SAC's temperature)
+  long buffer_size = 1'000'000;  // replay capacity in transitions
+  long learning_starts = 100;    // transitions collected (random actions) before training
+  int batch_size = 256;          // minibatch size
+  double tau = 0.005;            // Polyak coefficient of the target networks
+  double gamma = 0.99;           // discount factor
+  int train_freq = 1;            // vector steps between trainings (SB3 train_freq, "step")
+  int gradient_steps = 1;        // updates per training
+  int report_every = 1000;       // vector steps between progress reports (not SB3)
+  void bind(Hyperparameters& table);
+  void check(std::string_view algorithm) const;  // UserError for a bad value
+};
+
+// Network sizes (SB3's off-policy defaults: net_arch [256, 256], ReLU, no orthogonal init).
+struct OffPolicyNetworkConfig {
+  std::vector<int> pi_layers{256, 256};  // actor MLP hidden sizes (SB3 net_arch pi)
+  std::vector<int> qf_layers{256, 256};  // each critic's MLP hidden sizes (SB3 net_arch qf)
+  std::string activation = "relu";       // "relu" or "tanh" (SB3 activation_fn, nn.ReLU)
+  int cnn_features = 256;                // NatureCNN output size per image (SB3 features_dim)
+  void bind(Hyperparameters& table);
+};
+
+// n Q(s, a) networks on one encoder of their own (SB3 ContinuousCritic with
+// share_features_extractor=False): Q_i = MLP_i([encoder(s), a]) -> 1.
+class CriticImpl : public torch::nn::Module {
+ public:
+  CriticImpl(const ObsShape& shape, int action_size, int critics,
+             const OffPolicyNetworkConfig& config, at::Generator& generator);
+  // [critics, B]: every Q of (observation, actions).
+  torch::Tensor forward(const ObsBatch& observation, const torch::Tensor& actions);
+  // [B]: the first Q only (TD3's actor loss).
+  torch::Tensor q1(const ObsBatch& observation, const torch::Tensor& actions);
+
+ private:
+  MultiInputEncoder encoder_{nullptr};
+  std::vector<torch::nn::Sequential> q_;
+};
+TORCH_MODULE(Critic);
+
+// A network's parameters packed (PackedParameters) with a target copy of the same layout.
+// target <- tau * online + (1 - tau) * target is then one operation on two tensors.
+void polyak_update(torch::Tensor& target, const torch::Tensor& online, double tau);
+
+// Every setting of an off-policy learner: the algorithm's own (`Own`, with a bind(table)), the
+// loop's, the networks' and the observation's, parsed strictly from LearnerOptions.
+template <typename Own>
+struct OffPolicySettings {
+  Own own;
+  OffPolicyConfig loop;
+  OffPolicyNetworkConfig networks;
+  ObservationConfig observation;
+  std::string text;  // every value, "name = value" lines
+};
+
+// Binds every setting (defaults: `own` and `loop` as given), applies the overrides and checks
+// the loop's values. Throws UserError for an unknown name or a bad value.
+template <typename Own>
+OffPolicySettings<Own> parse_off_policy_settings(std::string_view algorithm,
+                                                 const LearnerOptions& options, Own own,
+                                                 OffPolicyConfig loop) {
+  apply_torch_options(options);
+  OffPolicySettings<Own> settings{.own = std::move(own), .loop = loop};
+  Hyperparameters table;
+  settings.own.bind(table);
+  settings.loop.bind(table);
+  settings.networks.bind(table);
+  settings.observation.bind(table);
+  table.apply(options.hyperparameters);
+  settings.loop.check(algorithm);
+  settings.text = table.to_text();
+  return settings;
+}
+
+// The learner skeleton. An algorithm builds its networks and optimisers in its constructor,
+// registers what its checkpoint holds, and implements the two methods below.
+class OffPolicyLearner : public Learner {
+ public:
+  std::string_view algorithm() const override { return algorithm_; }
+  long steps() const override { return steps_; }
+  std::string config_text() const override { return text_; }
+  void learn(long total_steps, const ProgressFn& on_progress) override;
+  void save(const std::filesystem::path& file) const override;
+  void load(const std::filesystem::path& file) override;
+  void act(const envs::ObservationBuffers& observation, std::span<double> action,
+           bool deterministic) override;
+
+ protected:
+  // Throws UserError for an action space without finite bounds or a replay buffer too large
+  // for the machine.
+  OffPolicyLearner(std::string algorithm, VecEnv& env, const LearnerOptions& options,
+                   const OffPolicyConfig& loop, const ObservationConfig& observation,
+                   std::string text);
+
+  // Actions in [-1, 1] for the current observations: the behaviour policy (deterministic:
+  // the policy's best guess, for evaluation). [rows, action_size].
+  virtual torch::Tensor policy_action(const ObsBatch& observation, bool deterministic) = 0;
+  // One gradient step on a minibatch (observations already normalised). `update` counts the
+  // updates since the start of training, this one included (TD3's delay).
+  virtual void train(const ReplayBuffer::Sample& batch, long update) = 0;
+  // A loss or diagnostic of an update; each report gives the mean of each name's values.
+  void record(const std::string& name, double value);
+
+  // What the checkpoint holds besides the normaliser, generator and counters.
+  void checkpoint_module(std::string key, torch::nn::Module& module);
+  void checkpoint_optimizer(std::string key, torch::optim::Optimizer& optimizer);
+  void checkpoint_tensor(std::string key, torch::Tensor& tensor);
+
+  const ObsShape& shape() const { return pipeline_.shape(); }
+  int action_size() const { return env_.action_space().size(); }
+  at::Generator& generator() { return generator_; }
+
+ private:
+  std::uint64_t draw_seed();
+
+  const std::string algorithm_;
+  VecEnv& env_;
+  const OffPolicyConfig config_;
+  const ObservationConfig observation_;
+  const std::string text_;  // every value, "name = value" lines
+  at::Generator generator_;
+  ObservationPipeline pipeline_;
+  ReplayBuffer buffer_;
+  TransitionCollector collector_;
+  ObsBatch scratch_;  // one row, for act()
+  long steps_ = 0, vector_steps_ = 0, updates_ = 0;
+  std::map<std::string, std::pair<double, long>> records_;  // sum and count since the report
+  std::vector<std::pair<std::string, torch::nn::Module*>> modules_;
+  std::vector<std::pair<std::string, torch::optim::Optimizer*>> optimizers_;
+  std::vector<std::pair<std::string, torch::Tensor*>> tensors_;
+};
+
+}  // namespace cradle::learn

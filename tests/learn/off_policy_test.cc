@@ -1,0 +1,368 @@
+// SAC, TD3 and DDPG: the replay buffer's bookkeeping under next-step autoreset, its memory
+// check, strict hyperparameters, checkpoints, and learning on the inline Pendulum swing-up.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "learn/learner.h"
+#include "learn/replay_buffer.h"
+#include "test_tasks.h"
+
+namespace cradle::learn {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// A scripted env: observation [length, episode, t], reward 100 episode + t after step t,
+// episodes of `length` steps that end terminated when the episode number is even, truncated
+// when odd.
+class ScriptedEnv final : public envs::Env {
+ public:
+  ScriptedEnv(int length, double bound)
+      : space_(make_space()),
+        action_space_(Box::uniform({1}, DType::kFloat32, -bound, bound)),
+        obs_(space_),
+        length_(length) {}
+  const DictSpace& observation_space() const override { return space_; }
+  const Box& action_space() const override { return action_space_; }
+  const envs::ObservationBuffers& observation() const override { return obs_; }
+  const envs::Info& info() const override { return info_; }
+  void reset(std::optional<std::uint64_t>) override {
+    ++episode_;
+    t_ = 0;
+    info_.steps = 0;
+    observe();
+  }
+  envs::StepResult step(std::span<const double> action) override {
+    last_action_ = action[0];
+    ++t_;
+    info_.steps = t_;
+    observe();
+    const bool ended = t_ == length_;
+    return {.reward = 100.0 * episode_ + t_,
+            .terminated = ended && episode_ % 2 == 0,
+            .truncated = ended && episode_ % 2 == 1};
+  }
+  double last_action() const { return last_action_; }
+
+ private:
+  static DictSpace make_space() {
+    DictSpace space;
+    space.entries.push_back({"observation", Box::unbounded({3}, DType::kFloat64)});
+    return space;
+  }
+  void observe() {
+    obs_.f64(0)[0] = length_;
+    obs_.f64(0)[1] = episode_;
+    obs_.f64(0)[2] = t_;
+  }
+  DictSpace space_;
+  Box action_space_;
+  envs::ObservationBuffers obs_;
+  envs::Info info_;
+  int length_, episode_ = -1, t_ = 0;
+  double last_action_ = 0;
+};
+
+std::unique_ptr<ThreadedVecEnv> make_scripted(std::vector<int> lengths, double bound = 2.0) {
+  std::vector<std::unique_ptr<envs::Env>> list;
+  for (int length : lengths) list.push_back(std::make_unique<ScriptedEnv>(length, bound));
+  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+}
+
+TEST(ReplayBuffer, StoresRealTransitionsAndSkipsAutoresets) {
+  auto env = make_scripted({3, 4});
+  ObservationPipeline pipeline(env->observation_space(), {.normalize_observations = false},
+                               nullptr);
+  ReplayBuffer buffer(1000, pipeline.shape(), 1);
+  TransitionCollector collector(*env, pipeline, {});
+  collector.start(1);
+  const int steps = 20;
+  for (int t = 0; t < steps; ++t) {
+    // Action 0.5 in [-1, 1] reaches the env as 1.0 in [-2, 2].
+    collector.step(torch::full({2, 1}, 0.5f), buffer);
+    EXPECT_DOUBLE_EQ(dynamic_cast<const ScriptedEnv&>(env->env(0)).last_action(), 1.0);
+  }
+  // Env 0: episodes of 3 steps + 1 autoreset step -> 20 / 4 * 3 = 15 transitions. Env 1:
+  // 5 steps per cycle -> 4 cycles x 4 = 16.
+  ASSERT_EQ(buffer.size(), 31);
+  const ReplayBuffer::Sample all = buffer.gather(torch::arange(buffer.size()));
+  int terminated = 0, truncated = 0;
+  for (long i = 0; i < buffer.size(); ++i) {
+    const auto row = all.observations.vector[i];
+    const auto next = all.next_observations.vector[i];
+    const float length = row[0].item<float>(), episode = row[1].item<float>();
+    const float t = row[2].item<float>(), next_t = next[2].item<float>();
+    // (s, a, r, s') of one episode: s' is the step after s, never another episode's start.
+    EXPECT_EQ(next[0].item<float>(), length);
+    EXPECT_EQ(next[1].item<float>(), episode);
+    EXPECT_EQ(next_t, t + 1);
+    EXPECT_LT(t, length);  // no transition starts from a final observation
+    EXPECT_FLOAT_EQ(all.rewards[i].item<float>(), 100.0f * episode + next_t);
+    EXPECT_FLOAT_EQ(all.actions[i][0].item<float>(), 0.5f);
+    // Terminated only on the last step of an even episode; a truncated last step (odd
+    // episode) is stored as an ordinary transition whose s' is the final observation.
+    const bool last = next_t == length;
+    const bool even = static_cast<int>(episode) % 2 == 0;
+    EXPECT_EQ(all.terminated[i].item<float>(), last && even ? 1.0f : 0.0f);
+    terminated += last && even;
+    truncated += last && !even;
+  }
+  // Env 0 ended episodes 0..4 (0, 2, 4 terminated), env 1 episodes 0..3 (0, 2 terminated).
+  EXPECT_EQ(terminated, 5);
+  EXPECT_EQ(truncated, 4);
+}
+
+TEST(ReplayBuffer, OverwritesTheOldestWhenFull) {
+  auto env = make_scripted({100});
+  ObservationPipeline pipeline(env->observation_space(), {.normalize_observations = false},
+                               nullptr);
+  ReplayBuffer buffer(5, pipeline.shape(), 1);
+  TransitionCollector collector(*env, pipeline, {});
+  collector.start(1);
+  for (int t = 0; t < 12; ++t) collector.step(torch::zeros({1, 1}), buffer);
+  ASSERT_EQ(buffer.size(), 5);
+  // Transitions 0..11 written in a ring of 5: slots hold t = 10, 11, 7, 8, 9.
+  const ReplayBuffer::Sample all = buffer.gather(torch::arange(5));
+  const std::vector<float> expected = {10, 11, 7, 8, 9};
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(all.observations.vector[i][2].item<float>(), expected[i]);
+}
+
+TEST(ReplayBuffer, MemoryRuleNamesBufferSizeAndBytes) {
+  // Two 64x64x3 eyes and 100 floats: (2 x 2 x 12,288) + 800 + 80 + 5 bytes a transition.
+  const ObsShape eyes{.vector_size = 100, .images = {{64, 64, 3}, {64, 64, 3}}};
+  EXPECT_DOUBLE_EQ(replay_bytes(1, eyes, 20), 49152 + 800 + 80 + 5);
+  EXPECT_NEAR(replay_bytes(1'000'000, eyes, 20), 50.0e9, 0.1e9);
+  try {
+    check_replay_memory("sac", 1'000'000, eyes, 20, /*limit_bytes=*/8e9);
+    FAIL() << "expected a UserError";
+  } catch (const UserError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("buffer_size = 1000000"), std::string::npos) << message;
+    EXPECT_NE(message.find("50.0 GB"), std::string::npos) << message;
+  }
+  EXPECT_NO_THROW(check_replay_memory("sac", 100'000, eyes, 20, 8e9));
+  EXPECT_THROW(check_replay_memory("sac", 0, eyes, 20, 8e9), UserError);
+  // Through the learners, against this machine's memory: a buffer no machine holds.
+  auto env = testing::make_cartpoles(1, 30, /*with_image=*/true);
+  for (const char* algorithm : {"sac", "td3", "ddpg"}) {
+    EXPECT_THROW(make_learner(algorithm, *env, {.hyperparameters = {{"buffer_size", "100000000"}}}),
+                 UserError)
+        << algorithm;
+  }
+}
+
+TEST(OffPolicy, RejectsBadSettingsAndUnboundedActions) {
+  auto env = testing::make_cartpoles(1, 30);
+  const std::vector<std::pair<std::string, std::map<std::string, std::string>>> bad = {
+      {"sac", {{"ent_coef", "autox"}}},
+      {"sac", {{"ent_coef", "-1"}}},
+      {"sac", {{"ent_coef", "auto_abc"}}},
+      {"sac", {{"target_entropy", "high"}}},
+      {"sac", {{"batch_size", "0"}}},
+      {"sac", {{"tau", "2"}}},
+      {"sac", {{"n_critics", "0"}}},
+      {"sac", {{"buffer_size", "0"}}},
+      {"sac", {{"n_stepz", "1"}}},
+      {"td3", {{"policy_delay", "0"}}},
+      {"td3", {{"exploration_noise", "-1"}}},
+      {"td3", {{"learning_rate", "fast"}}},
+      {"ddpg", {{"policy_delay", "2"}}},
+      {"ddpg", {{"n_critics", "2"}}},
+  };
+  for (const auto& [algorithm, hyperparameters] : bad) {
+    EXPECT_THROW(make_learner(algorithm, *env, {.hyperparameters = hyperparameters}), UserError)
+        << algorithm << " " << hyperparameters.begin()->first;
+  }
+  auto unbounded = make_scripted({5}, std::numeric_limits<double>::infinity());
+  EXPECT_THROW(make_learner("sac", *unbounded, {}), UserError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checkpoints
+
+// Small networks and buffer, so the tests stay quick.
+std::map<std::string, std::string> small(std::map<std::string, std::string> extra = {}) {
+  std::map<std::string, std::string> hp = {{"pi_layers", "32,32"},    {"qf_layers", "32,32"},
+                                           {"batch_size", "32"},      {"buffer_size", "2000"},
+                                           {"learning_starts", "50"}, {"report_every", "64"}};
+  for (const auto& [name, value] : extra) hp[name] = value;
+  return hp;
+}
+
+std::vector<double> actions_of(Learner& learner, bool with_image, bool deterministic) {
+  auto env = testing::make_cartpoles(1, 200, with_image);
+  env->reset(123);
+  std::vector<double> actions;
+  const std::vector<double> push = {1.5};
+  for (int i = 0; i < 5; ++i) {
+    double a = 0;
+    learner.act(env->observation(0), {&a, 1}, deterministic);
+    actions.push_back(a);
+    env->step(push);
+  }
+  return actions;
+}
+
+std::vector<double> train_losses(Learner& learner, long steps) {
+  std::vector<double> losses;
+  learner.learn(steps, [&](const TrainStats& stats) {
+    for (const auto& [name, value] : stats.losses) losses.push_back(value);
+    return true;
+  });
+  return losses;
+}
+
+void check_checkpoint(const std::string& algorithm, bool with_image) {
+  SCOPED_TRACE(algorithm);
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("cradle_" + algorithm + "_offpolicy.pt");
+  auto env_a = testing::make_cartpoles(2, 30, with_image);
+  auto env_b = testing::make_cartpoles(2, 30, with_image);
+  auto a = make_learner(algorithm, *env_a, {.seed = 3, .hyperparameters = small()});
+  auto b = make_learner(algorithm, *env_b, {.seed = 99, .hyperparameters = small()});
+  // Images make every update a few CNN passes: fewer steps then.
+  const long steps = with_image ? 100 : 200, more = with_image ? 64 : 256;
+  EXPECT_FALSE(train_losses(*a, steps).empty());
+  EXPECT_NE(actions_of(*a, with_image, true), actions_of(*b, with_image, true));
+  a->save(file);
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
+  b->load(file);
+  EXPECT_EQ(b->steps(), a->steps());
+  const CheckpointInfo info = read_checkpoint_info(file);
+  EXPECT_EQ(info.algorithm, algorithm);
+  EXPECT_EQ(info.config, a->config_text());
+
+  // Deterministic actions, then sampled ones (same generator state), agree.
+  const std::vector<double> deterministic = actions_of(*a, with_image, true);
+  EXPECT_EQ(deterministic, actions_of(*b, with_image, true));
+  EXPECT_EQ(actions_of(*a, with_image, false), actions_of(*b, with_image, false));
+  for (double action : deterministic) EXPECT_LE(std::fabs(action), 3.0);
+
+  // The loaded learner continues: its empty buffer refills (learning_starts transitions)
+  // before it trains again.
+  long buffer = 0;
+  b->learn(b->steps() + more, [&](const TrainStats& stats) {
+    buffer = static_cast<long>(stats.losses.at("buffer_transitions"));
+    return true;
+  });
+  EXPECT_GE(b->steps(), a->steps() + more);
+  EXPECT_GT(buffer, more / 2);  // what this learn() call collected, autoreset steps aside
+  EXPECT_LE(buffer, more);
+
+  // Another algorithm's or another shape's learner refuses the file.
+  auto env_c = testing::make_cartpoles(1, 30, with_image);
+  auto other =
+      make_learner(algorithm == "sac" ? "td3" : "sac", *env_c, {.hyperparameters = small()});
+  EXPECT_THROW(other->load(file), UserError);
+  auto wide = make_learner(algorithm, *env_c, {.hyperparameters = small({{"qf_layers", "16"}})});
+  EXPECT_THROW(wide->load(file), UserError);
+  std::filesystem::remove(file);
+}
+
+TEST(OffPolicyCheckpoint, SacWithImagesRestoresActions) { check_checkpoint("sac", true); }
+TEST(OffPolicyCheckpoint, Td3RestoresActions) { check_checkpoint("td3", false); }
+TEST(OffPolicyCheckpoint, DdpgRestoresActions) { check_checkpoint("ddpg", false); }
+
+TEST(Sac, DeterministicGivenTheSeed) {
+  auto env_a = testing::make_cartpoles(2, 30);
+  auto env_b = testing::make_cartpoles(2, 30);
+  auto a = make_learner("sac", *env_a, {.seed = 7, .hyperparameters = small()});
+  auto b = make_learner("sac", *env_b, {.seed = 7, .hyperparameters = small()});
+  const std::vector<double> losses = train_losses(*a, 300);
+  EXPECT_FALSE(losses.empty());
+  EXPECT_EQ(losses, train_losses(*b, 300));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Learning: Pendulum swing-up (episodes of 200 steps). A random policy scores about -1,200;
+// swinging up and balancing scores above -400 (about -150 from most starts).
+
+constexpr int kPendulumSteps = 200;
+
+double random_pendulum_return(int episodes) {
+  testing::Pendulum env(testing::pendulum_model(), kPendulumSteps);
+  Rng rng(5);
+  double total = 0;
+  env.reset(1);
+  for (int e = 0; e < episodes; ++e) {
+    if (e > 0) env.reset(std::nullopt);
+    for (int t = 0; t < kPendulumSteps; ++t) {
+      const double action = rng.uniform(-2, 2);
+      total += env.step({&action, 1}).reward;
+    }
+  }
+  return total / episodes;
+}
+
+// Mean return of `episodes` deterministic episodes of the learner's policy.
+double policy_pendulum_return(Learner& learner, int episodes) {
+  testing::Pendulum env(testing::pendulum_model(), kPendulumSteps);
+  double total = 0;
+  env.reset(77);
+  for (int e = 0; e < episodes; ++e) {
+    if (e > 0) env.reset(std::nullopt);
+    for (int t = 0; t < kPendulumSteps; ++t) {
+      double action = 0;
+      learner.act(env.observation(), {&action, 1}, /*deterministic=*/true);
+      total += env.step({&action, 1}).reward;
+    }
+  }
+  return total / episodes;
+}
+
+struct PendulumRun {
+  double random, learned, seconds;
+};
+
+PendulumRun learn_pendulum(const std::string& algorithm, long steps,
+                           std::map<std::string, std::string> hp) {
+  const auto start = std::chrono::steady_clock::now();
+  auto env = testing::make_pendulums(1, kPendulumSteps);
+  auto learner = make_learner(algorithm, *env, {.seed = 1, .hyperparameters = hp});
+  std::vector<double> returns;
+  learner->learn(steps, [&](const TrainStats& stats) {
+    if (!std::isnan(stats.episodic_return)) returns.push_back(stats.episodic_return);
+    return true;
+  });
+  PendulumRun run{.random = random_pendulum_return(20),
+                  .learned = policy_pendulum_return(*learner, 10)};
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "%s pendulum, %ld steps: random %.0f -> deterministic policy %.0f (%.1f s); "
+      "training returns:",
+      algorithm.c_str(), steps, run.random, run.learned, run.seconds);
+  for (double r : returns) std::printf(" %.0f", r);
+  std::printf("\n");
+  return run;
+}
+
+const std::map<std::string, std::string> kPendulumHp = {{"pi_layers", "64,64"},
+                                                        {"qf_layers", "64,64"},
+                                                        {"batch_size", "128"},
+                                                        {"learning_rate", "1e-3"},
+                                                        {"report_every", "1000"}};
+
+TEST(Sac, LearnsPendulumSwingUp) {
+  const PendulumRun run = learn_pendulum("sac", 6000, kPendulumHp);
+  EXPECT_LT(run.random, -900);
+  EXPECT_GT(run.learned, -400);
+}
+
+TEST(Td3, ImprovesOnPendulum) {
+  const PendulumRun run = learn_pendulum("td3", 6000, kPendulumHp);
+  EXPECT_GT(run.learned, run.random + 400);
+}
+
+TEST(Ddpg, ImprovesOnPendulum) {
+  const PendulumRun run = learn_pendulum("ddpg", 6000, kPendulumHp);
+  EXPECT_GT(run.learned, run.random + 400);
+}
+
+}  // namespace
+}  // namespace cradle::learn
