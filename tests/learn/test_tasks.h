@@ -8,7 +8,8 @@
 // optional 64x64x3 uint8 "eye" image (a pattern drawn from the state) to exercise the CNN path.
 //
 // Pendulum: a torque-driven pendulum to swing up and balance (Gymnasium's Pendulum-v1 dynamics
-// in MJCF: a 1 m, 1 kg rod hinged at one end, g = 10, torque in [-2, 2], 0.05 s per step).
+// in MJCF: a 1 m, 1 kg rod hinged at one end, g = 10, torque in [-2, 2], 0.05 s per step,
+// angular velocity clipped to +-8 rad/s).
 // Reward -(angle^2 + 0.1 velocity^2 + 0.001 torque^2) with the angle from upright in
 // [-pi, pi]; episodes start at a random angle and are truncated after max_steps (never
 // terminated). The observation is {"observation": [cos angle, sin angle, angular velocity]}.
@@ -52,19 +53,24 @@ inline constexpr char kCartPoleXml[] = R"(
 </mujoco>
 )";
 
-// One compiled model shared by every CartPole (read-only after loading).
-inline std::shared_ptr<const mjModel> cartpole_model() {
+// Compiles inline MJCF (through a virtual file system).
+inline std::shared_ptr<const mjModel> compile_inline(const char* name, const char* xml,
+                                                     size_t size) {
   char error[1000] = "";
   mjVFS vfs;
   mj_defaultVFS(&vfs);
-  mj_makeEmptyFileVFS(&vfs, "cartpole.xml", sizeof(kCartPoleXml));
-  const int file = mj_findFileVFS(&vfs, "cartpole.xml");
-  std::copy(kCartPoleXml, kCartPoleXml + sizeof(kCartPoleXml),
-            static_cast<char*>(vfs.filedata[file]));
-  mjModel* model = mj_loadXML("cartpole.xml", &vfs, error, sizeof(error));
+  mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(size));
+  const int file = mj_findFileVFS(&vfs, name);
+  std::copy(xml, xml + size, static_cast<char*>(vfs.filedata[file]));
+  mjModel* model = mj_loadXML(name, &vfs, error, sizeof(error));
   mj_deleteVFS(&vfs);
-  if (model == nullptr) throw std::runtime_error(std::string("cartpole: ") + error);
+  if (model == nullptr) throw std::runtime_error(std::string(name) + ": " + error);
   return {model, mj_deleteModel};
+}
+
+// One compiled model shared by every CartPole (read-only after loading).
+inline std::shared_ptr<const mjModel> cartpole_model() {
+  return compile_inline("cartpole.xml", kCartPoleXml, sizeof(kCartPoleXml));
 }
 
 class CartPole final : public envs::Env {
@@ -181,23 +187,14 @@ inline constexpr char kPendulumXml[] = R"(
 
 // One compiled model shared by every Pendulum.
 inline std::shared_ptr<const mjModel> pendulum_model() {
-  char error[1000] = "";
-  mjVFS vfs;
-  mj_defaultVFS(&vfs);
-  mj_makeEmptyFileVFS(&vfs, "pendulum.xml", sizeof(kPendulumXml));
-  const int file = mj_findFileVFS(&vfs, "pendulum.xml");
-  std::copy(kPendulumXml, kPendulumXml + sizeof(kPendulumXml),
-            static_cast<char*>(vfs.filedata[file]));
-  mjModel* model = mj_loadXML("pendulum.xml", &vfs, error, sizeof(error));
-  mj_deleteVFS(&vfs);
-  if (model == nullptr) throw std::runtime_error(std::string("pendulum: ") + error);
-  return {model, mj_deleteModel};
+  return compile_inline("pendulum.xml", kPendulumXml, sizeof(kPendulumXml));
 }
 
 class Pendulum final : public envs::Env {
  public:
   static constexpr int kFrameSkip = 5;  // 0.05 s per step
   static constexpr double kMaxTorque = 2.0;
+  static constexpr double kMaxSpeed = 8.0;  // rad/s, Gymnasium's clip
 
   Pendulum(std::shared_ptr<const mjModel> model, int max_steps)
       : model_(std::move(model)),
@@ -227,7 +224,10 @@ class Pendulum final : public envs::Env {
     const double angle = std::remainder(data_->qpos[0], 2 * M_PI);  // from upright, [-pi, pi]
     const double velocity = data_->qvel[0];
     data_->ctrl[0] = torque;
-    for (int i = 0; i < kFrameSkip; ++i) mj_step(model_.get(), data_.get());
+    for (int i = 0; i < kFrameSkip; ++i) {
+      mj_step(model_.get(), data_.get());
+      data_->qvel[0] = std::clamp(data_->qvel[0], -kMaxSpeed, kMaxSpeed);
+    }
     ++info_.steps;
     observe();
     envs::StepResult result{
