@@ -159,15 +159,22 @@ void write_module(torch::serialize::OutputArchive& archive, const std::string& k
   archive.write(key, nested);
 }
 
-void read_module(torch::serialize::InputArchive& archive, const std::string& key,
-                 torch::nn::Module& module) {
+std::function<void()> stage_module(torch::serialize::InputArchive& archive, const std::string& key,
+                                   torch::nn::Module& module) {
   torch::serialize::InputArchive nested;
   archive.read(key, nested);
   std::vector<std::pair<torch::Tensor, torch::Tensor>> staged;
   stage_tensors(nested, module, key + ".", staged);
-  // Every shape matched: copy in place (the tensors keep their storage).
-  torch::NoGradGuard no_grad;
-  for (auto& [destination, stored] : staged) destination.copy_(stored);
+  // Every shape matched: the copy is in place (the tensors keep their storage).
+  return [staged = std::move(staged)] {
+    torch::NoGradGuard no_grad;
+    for (const auto& [destination, stored] : staged) destination.copy_(stored);
+  };
+}
+
+void read_module(torch::serialize::InputArchive& archive, const std::string& key,
+                 torch::nn::Module& module) {
+  stage_module(archive, key, module)();
 }
 
 void write_optimizer(torch::serialize::OutputArchive& archive, const std::string& key,

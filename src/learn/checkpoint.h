@@ -38,6 +38,10 @@ void write_module(torch::serialize::OutputArchive& archive, const std::string& k
                   const torch::nn::Module& module);
 void read_module(torch::serialize::InputArchive& archive, const std::string& key,
                  torch::nn::Module& module);
+// read_module in two halves, for checkpoints of several modules: reads and checks every shape
+// (nothing changes; UserError on a mismatch) and returns the copy to run once all have passed.
+std::function<void()> stage_module(torch::serialize::InputArchive& archive, const std::string& key,
+                                   torch::nn::Module& module);
 void write_optimizer(torch::serialize::OutputArchive& archive, const std::string& key,
                      const torch::optim::Optimizer& optimizer);
 void read_optimizer(torch::serialize::InputArchive& archive, const std::string& key,

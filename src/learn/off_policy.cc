@@ -1,6 +1,7 @@
 #include "learn/off_policy.h"
 
 #include <chrono>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -202,7 +203,7 @@ void OffPolicyLearner::load(const std::filesystem::path& file) {
   const CheckpointInfo info = read_checkpoint(
       file, algorithm_, [&](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
         observation_.check_matches(header.config);
-        // Tensors first: their shapes are checked before anything changes.
+        // Every module's and tensor's shape is checked before anything changes.
         std::vector<torch::Tensor> stored(tensors_.size());
         for (size_t i = 0; i < tensors_.size(); ++i) {
           archive.read(tensors_[i].first, stored[i]);
@@ -213,7 +214,11 @@ void OffPolicyLearner::load(const std::filesystem::path& file) {
             throw UserError(message.str());
           }
         }
-        for (const auto& [key, module] : modules_) read_module(archive, key, *module);
+        std::vector<std::function<void()>> copies;
+        for (const auto& [key, module] : modules_) {
+          copies.push_back(stage_module(archive, key, *module));
+        }
+        for (const auto& copy : copies) copy();
         for (const auto& [key, optimizer] : optimizers_) read_optimizer(archive, key, *optimizer);
         torch::NoGradGuard no_grad;
         for (size_t i = 0; i < tensors_.size(); ++i) tensors_[i].second->copy_(stored[i]);

@@ -260,8 +260,12 @@ void check_checkpoint(const std::string& algorithm, bool with_image) {
   auto other =
       make_learner(algorithm == "sac" ? "td3" : "sac", *env_c, {.hyperparameters = small()});
   EXPECT_THROW(other->load(file), UserError);
+  // Critics of another shape: refused before anything changes (the actor, read first, fits).
   auto wide = make_learner(algorithm, *env_c, {.hyperparameters = small({{"qf_layers", "16"}})});
+  const std::vector<double> before = actions_of(*wide, with_image, true);
   EXPECT_THROW(wide->load(file), UserError);
+  EXPECT_EQ(actions_of(*wide, with_image, true), before);
+  EXPECT_EQ(wide->steps(), 0);
   std::filesystem::remove(file);
 }
 
