@@ -75,6 +75,14 @@ void polyak_update(torch::Tensor& target, const torch::Tensor& online, double ta
   target.mul_(1.0 - tau).add_(online, tau);
 }
 
+FrozenParameters::FrozenParameters(torch::nn::Module& module) : parameters_(module.parameters()) {
+  for (torch::Tensor& p : parameters_) p.requires_grad_(false);
+}
+
+FrozenParameters::~FrozenParameters() {
+  for (torch::Tensor& p : parameters_) p.requires_grad_(true);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The learner skeleton
 

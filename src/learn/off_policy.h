@@ -106,6 +106,20 @@ OffPolicySettings<Own> parse_off_policy_settings(std::string_view algorithm,
   return settings;
 }
 
+// Turns off the gradients of a module's parameters for its lifetime: the critics scoring the
+// actor's actions pass gradients to the actions only, which spares computing (and then
+// discarding) their weights' gradients.
+class FrozenParameters {
+ public:
+  explicit FrozenParameters(torch::nn::Module& module);
+  ~FrozenParameters();
+  FrozenParameters(const FrozenParameters&) = delete;
+  FrozenParameters& operator=(const FrozenParameters&) = delete;
+
+ private:
+  std::vector<torch::Tensor> parameters_;
+};
+
 // The learner skeleton. An algorithm builds its networks and optimisers in its constructor,
 // registers what its checkpoint holds, and implements the two methods below.
 class OffPolicyLearner : public Learner {

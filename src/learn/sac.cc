@@ -198,12 +198,16 @@ class Sac final : public OffPolicyLearner {
     qf_loss.backward();
     critic_optimizer_.step();
 
-    // Actor: maximise min Q minus alpha log pi (its gradient also reaches the critics' packed
-    // gradient, which the next critic step zeroes first).
-    const torch::Tensor q_pi = std::get<0>(critic_->forward(batch.observations, pi_actions).min(0));
-    const torch::Tensor actor_loss = (alpha * log_pi - q_pi).mean();
-    actor_parameters_.zero_grad();
-    actor_loss.backward();
+    // Actor: maximise min Q minus alpha log pi (the critics pass gradients to the actions only).
+    torch::Tensor actor_loss;
+    {
+      const FrozenParameters frozen(*critic_);
+      const torch::Tensor q_pi =
+          std::get<0>(critic_->forward(batch.observations, pi_actions).min(0));
+      actor_loss = (alpha * log_pi - q_pi).mean();
+      actor_parameters_.zero_grad();
+      actor_loss.backward();
+    }
     actor_optimizer_.step();
 
     if (update % config_.target_update_interval == 0) {

@@ -152,10 +152,13 @@ class Td3 final : public OffPolicyLearner {
 
     // Delayed: the actor ascends Q_1, then the targets follow.
     if (update % config_.policy_delay != 0) return;
-    const torch::Tensor actor_loss =
-        -critic_->q1(batch.observations, actor_->forward(batch.observations)).mean();
-    actor_parameters_.zero_grad();
-    actor_loss.backward();
+    torch::Tensor actor_loss;
+    {
+      const FrozenParameters frozen(*critic_);  // gradients to the actions only
+      actor_loss = -critic_->q1(batch.observations, actor_->forward(batch.observations)).mean();
+      actor_parameters_.zero_grad();
+      actor_loss.backward();
+    }
     actor_optimizer_.step();
     polyak_update(critic_target_parameters_.tensor(), critic_parameters_.tensor(), loop_.tau);
     polyak_update(actor_target_parameters_.tensor(), actor_parameters_.tensor(), loop_.tau);
