@@ -2,6 +2,10 @@
 no Python per step) vs the Python loop over env.step(), and vector-env throughput from Python
 (cradle.VectorEnv.step, batched numpy copies) vs the C++ vector loop.
 
+Physics time varies by more than the overhead on a shared machine, so the overhead is also
+measured within each run: loop wall time minus the time spent inside the C++ env's steps (its
+own profile), Python loop minus C++ loop.
+
     PYTHONPATH=build/python /usr/bin/python3 bench/python_overhead.py [--steps 3000] [--envs 2]
 """
 
@@ -29,6 +33,22 @@ def python_loop(env, actions):
     return time.perf_counter() - start
 
 
+def per_step_overhead(env, actions):
+    """Per step: wall time of env.step() from Python minus the C++ env's own time for that step.
+    The median is robust to the preemptions of a shared machine (most steps see none)."""
+    core = env._core
+    out = np.empty(len(actions))
+    for i, a in enumerate(actions):
+        p0 = core.profile_seconds
+        t0 = time.perf_counter()
+        obs, reward, terminated, truncated, info = env.step(a)
+        t1 = time.perf_counter()
+        out[i] = (t1 - t0) - (core.profile_seconds - p0)
+        if terminated or truncated:
+            env.reset()
+    return out
+
+
 def vector_loop(vec, actions):
     start = time.perf_counter()
     for a in actions:
@@ -53,34 +73,52 @@ def main():
         env = cradle.make_env(config, training=False, copy_observations=copy)
         low, high = env.action_space.low, env.action_space.high
         actions = rng.uniform(low, high, (args.steps, low.size))
-        cpp, py = [], []
+        cpp, py, cpp_out, py_out = [], [], [], []
         for _ in range(args.repeats):
             env.reset(seed=0)
-            cpp.append(env._core.bench(actions) / args.steps)
+            env._core.clear_profile()
+            wall = env._core.bench(actions)
+            cpp.append(wall / args.steps)
+            cpp_out.append((wall - env._core.profile_seconds) / args.steps)
             env.reset(seed=0)
-            py.append(python_loop(env, actions) / args.steps)
-        results[copy] = (min(cpp), min(py))
+            env._core.clear_profile()
+            wall = python_loop(env, actions)
+            py.append(wall / args.steps)
+            py_out.append((wall - env._core.profile_seconds) / args.steps)
+        env.reset(seed=0)
+        each = per_step_overhead(env, actions)
+        results[copy] = (min(cpp), min(py), np.median(cpp_out), np.median(py_out), each)
         env.close()
-    for copy, (cpp, py) in results.items():
+    for copy, (cpp, py, cpp_out, py_out, each) in results.items():
         mode = "fresh arrays (default)" if copy else "views (copy_observations=False)"
-        print(f"single env, {mode}: C++ {cpp * 1e6:8.2f} µs/step, Python {py * 1e6:8.2f} µs/step, "
-              f"overhead {(py - cpp) * 1e6:6.2f} µs/step")
+        print(f"single env, {mode}: C++ loop {cpp * 1e6:7.1f} µs/step, Python loop "
+              f"{py * 1e6:7.1f} µs/step (best of {args.repeats}); outside the env step: C++ "
+              f"{cpp_out * 1e6:5.2f}, Python {py_out * 1e6:5.2f} -> overhead "
+              f"{(py_out - cpp_out) * 1e6:5.2f} µs/step (median)")
+        print(f"  per step, Python env.step() minus the C++ step inside it: median "
+              f"{np.median(each) * 1e6:.2f} µs, 10th-90th percentile {np.percentile(each, 10) * 1e6:.2f}"
+              f"-{np.percentile(each, 90) * 1e6:.2f} µs")
 
-    # Vector env: C++ vector steps vs cradle.VectorEnv.step (which also copies the batch).
-    vec = cradle.VectorEnv(config, num_envs=args.envs, threads=args.envs)
-    low, high = vec.single_action_space.low, vec.single_action_space.high
-    actions = rng.uniform(low, high, (args.steps, args.envs, low.size))
-    cpp, py = [], []
-    for _ in range(args.repeats):
+    # Vector env: C++ vector steps vs cradle.VectorEnv.step (which also copies the batch), in
+    # alternating blocks so that both see the same machine load; median of the block ratios.
+    for threads in sorted({1, args.envs}):
+        vec = cradle.VectorEnv(config, num_envs=args.envs, threads=threads)
+        low, high = vec.single_action_space.low, vec.single_action_space.high
+        block = 200
+        actions = rng.uniform(low, high, (block, args.envs, low.size))
         vec.reset(seed=0)
-        cpp.append(vec._core.bench(actions))
-        vec.reset(seed=0)
-        py.append(vector_loop(vec, actions))
-    cpp_sps = args.steps * args.envs / min(cpp)
-    py_sps = args.steps * args.envs / min(py)
-    print(f"vector env ({args.envs} envs, {vec.threads} threads): C++ {cpp_sps:8.0f} steps/s, "
-          f"Python {py_sps:8.0f} steps/s, Python/C++ {py_sps / cpp_sps:.3f}")
-    vec.close()
+        cpp, py = [], []
+        for _ in range(max(1, args.steps // block)):
+            cpp.append(vec._core.bench(actions))
+            py.append(vector_loop(vec, actions))
+        cpp, py = np.array(cpp), np.array(py)
+        steps = block * args.envs
+        print(f"vector env ({args.envs} envs, {vec.threads} threads, {len(cpp)} blocks of {block} "
+              f"steps): C++ {steps / np.median(cpp):6.0f} env steps/s, Python "
+              f"{steps / np.median(py):6.0f} env steps/s; Python/C++ throughput {np.median(cpp / py):.3f} "
+              f"(median of blocks); {(np.median(py) - np.median(cpp)) / block * 1e6:.1f} µs more "
+              f"per vector step")
+        vec.close()
 
 
 if __name__ == "__main__":

@@ -395,6 +395,15 @@ void bind_env(py::module_& m) {
       .def("close", &PyEnv::close)
       .def("bench", &PyEnv::bench, py::arg("actions"))
       .def_property_readonly("copies", &PyEnv::copies)
+      // Wall seconds spent inside the C++ env's steps since the last clear_profile(): the rest of
+      // a loop's time is the loop's own overhead (Python or C++).
+      .def_property_readonly("profile_seconds",
+                             [](PyEnv& e) {
+                               const envs::Profile& p = e.env().profile();
+                               return p.physics + p.touch + p.vision + p.proprio + p.vestibular +
+                                      p.other;
+                             })
+      .def("clear_profile", [](PyEnv& e) { e.env().clear_profile(); })
       .def_property_readonly("observation_space",
                              [](PyEnv& e) { return space_list(e.env().observation_space()); })
       .def_property_readonly("action_space",

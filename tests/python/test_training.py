@@ -91,3 +91,23 @@ def test_training_log_round_trip(make_config, tmp_path):
     assert cradle.training_score(str(pkl), "self_touch") == pytest.approx(union / 68)
     with pytest.raises(FileNotFoundError):
         cradle.load_training_log(tmp_path / "nothing_here.jsonl")
+
+
+def test_evaluate_with_python_policy(make_config):
+    config = make_config("selftouch")
+    seen = []
+
+    def policy(obs):
+        seen.append(obs["observation"].copy())
+        return np.zeros(30, dtype=np.float32)
+
+    report = cradle.evaluate(config, episodes=2, duration=15, render=False, policy=policy,
+                             quiet=True)
+    assert len(report["episodes"]) == 2 and len(seen) == 30
+    assert report["episodes"][0]["steps"] == 15
+    with pytest.raises(ValueError, match="policy must return 30 action values"):
+        cradle.evaluate(config, episodes=1, duration=5, render=False,
+                        policy=lambda obs: np.zeros(3), quiet=True)
+    with pytest.raises(FileNotFoundError):
+        cradle.evaluate(config, episodes=1, duration=5, render=False,
+                        policy=config["save_dir"] + "/missing.ckpt", quiet=True)
