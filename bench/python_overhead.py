@@ -73,28 +73,35 @@ def main():
         env = cradle.make_env(config, training=False, copy_observations=copy)
         low, high = env.action_space.low, env.action_space.high
         actions = rng.uniform(low, high, (args.steps, low.size))
-        cpp, py, cpp_out, py_out = [], [], [], []
+        cpp, py, cpp_out, py_out, cpp_cpu, py_cpu = [], [], [], [], [], []
         for _ in range(args.repeats):
             env.reset(seed=0)
             env._core.clear_profile()
+            cpu = time.process_time()
             wall = env._core.bench(actions)
+            cpp_cpu.append((time.process_time() - cpu) / args.steps)
             cpp.append(wall / args.steps)
             cpp_out.append((wall - env._core.profile_seconds) / args.steps)
             env.reset(seed=0)
             env._core.clear_profile()
+            cpu = time.process_time()
             wall = python_loop(env, actions)
+            py_cpu.append((time.process_time() - cpu) / args.steps)
             py.append(wall / args.steps)
             py_out.append((wall - env._core.profile_seconds) / args.steps)
         env.reset(seed=0)
         each = per_step_overhead(env, actions)
-        results[copy] = (min(cpp), min(py), np.median(cpp_out), np.median(py_out), each)
+        results[copy] = (min(cpp), min(py), np.median(cpp_out), np.median(py_out), each,
+                         min(cpp_cpu), min(py_cpu))
         env.close()
-    for copy, (cpp, py, cpp_out, py_out, each) in results.items():
+    for copy, (cpp, py, cpp_out, py_out, each, cpp_cpu, py_cpu) in results.items():
         mode = "fresh arrays (default)" if copy else "views (copy_observations=False)"
         print(f"single env, {mode}: C++ loop {cpp * 1e6:7.1f} µs/step, Python loop "
               f"{py * 1e6:7.1f} µs/step (best of {args.repeats}); outside the env step: C++ "
               f"{cpp_out * 1e6:5.2f}, Python {py_out * 1e6:5.2f} -> overhead "
               f"{(py_out - cpp_out) * 1e6:5.2f} µs/step (median)")
+        print(f"  CPU time (unaffected by waiting for a core): C++ loop {cpp_cpu * 1e6:.1f}, Python "
+              f"loop {py_cpu * 1e6:.1f} µs/step -> {(py_cpu - cpp_cpu) * 1e6:.2f} µs/step")
         print(f"  per step, Python env.step() minus the C++ step inside it: median "
               f"{np.median(each) * 1e6:.2f} µs, 10th-90th percentile {np.percentile(each, 10) * 1e6:.2f}"
               f"-{np.percentile(each, 90) * 1e6:.2f} µs")
@@ -107,17 +114,26 @@ def main():
         block = 200
         actions = rng.uniform(low, high, (block, args.envs, low.size))
         vec.reset(seed=0)
-        cpp, py = [], []
+        cpp, py, cpp_cpu, py_cpu, inside = [], [], [], [], []
         for _ in range(max(1, args.steps // block)):
+            cpu = time.process_time()
             cpp.append(vec._core.bench(actions))
+            cpp_cpu.append(time.process_time() - cpu)
+            cpu = time.process_time()
+            vec._core.clear_stepping()
             py.append(vector_loop(vec, actions))
-        cpp, py = np.array(cpp), np.array(py)
+            inside.append(vec._core.stepping_seconds)
+            py_cpu.append(time.process_time() - cpu)
+        cpp, py, inside = np.array(cpp), np.array(py), np.array(inside)
         steps = block * args.envs
         print(f"vector env ({args.envs} envs, {vec.threads} threads, {len(cpp)} blocks of {block} "
               f"steps): C++ {steps / np.median(cpp):6.0f} env steps/s, Python "
               f"{steps / np.median(py):6.0f} env steps/s; Python/C++ throughput {np.median(cpp / py):.3f} "
               f"(median of blocks); {(np.median(py) - np.median(cpp)) / block * 1e6:.1f} µs more "
-              f"per vector step")
+              f"per vector step; CPU time Python/C++ {np.sum(py_cpu) / np.sum(cpp_cpu):.3f}")
+        print(f"  within the Python loop: time inside the C++ vector step / loop time "
+              f"{np.median(inside / py):.4f} (median of blocks); outside it "
+              f"{np.median(py - inside) / block * 1e6:.1f} µs per vector step")
         vec.close()
 
 

@@ -44,10 +44,13 @@ class SB3VecEnv(_SB3VecEnv):
         return out
 
     def reset(self):
-        seed = self._seeds[0] if self._seeds and self._seeds[0] is not None else self._next_seed
+        # SB3 >= 2.2 keeps the seeds given to seed() in _seeds until the next reset.
+        seeds = getattr(self, "_seeds", None)
+        seed = seeds[0] if seeds and seeds[0] is not None else self._next_seed
         self._next_seed = None
         obs, infos = self._vec.reset(seed=seed)
-        self._reset_seeds()
+        if hasattr(self, "_reset_seeds"):
+            self._reset_seeds()
         self.reset_infos = self._infos(infos, None, None, None)
         return obs
 

@@ -72,7 +72,9 @@ class PyVecEnv {
     py::dict obs = allocate();
     {
       py::gil_scoped_release release;
+      const auto start = std::chrono::steady_clock::now();
       vec_->step({actions.data(), static_cast<size_t>(n)});
+      stepping_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!same_step_) gather();
     }
     const int envs = num_envs();
@@ -134,6 +136,11 @@ class PyVecEnv {
       vec_->step({a + t * per_step, static_cast<size_t>(per_step)});
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+
+  // Wall seconds spent inside the C++ vector's step() calls made by step(): the rest of a Python
+  // loop's time is the binding's and Python's overhead.
+  double stepping_seconds() const { return stepping_; }
+  void clear_stepping() { stepping_ = 0; }
 
   // The env i's info dict.
   py::dict info(int i) const { return info_dict(behavior_, vec_->info(i)); }
@@ -213,6 +220,7 @@ class PyVecEnv {
   std::unique_ptr<learn::ThreadedVecEnv> vec_;
   std::vector<Entry> entries_;
   std::vector<std::byte*> pointers_;
+  double stepping_ = 0;
 };
 
 namespace {
@@ -316,6 +324,8 @@ void bind_learn(py::module_& m) {
       .def("step", &PyVecEnv::step, py::arg("actions"))
       .def("bench", &PyVecEnv::bench, py::arg("actions"))
       .def("info", &PyVecEnv::info, py::arg("env"))
+      .def_property_readonly("stepping_seconds", &PyVecEnv::stepping_seconds)
+      .def("clear_stepping", &PyVecEnv::clear_stepping)
       .def("close", &PyVecEnv::close)
       .def_property_readonly("num_envs", &PyVecEnv::num_envs)
       .def_property_readonly("threads", &PyVecEnv::threads)
