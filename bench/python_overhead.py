@@ -100,10 +100,11 @@ def main():
               f"{py * 1e6:7.1f} µs/step (best of {args.repeats}); outside the env step: C++ "
               f"{cpp_out * 1e6:5.2f}, Python {py_out * 1e6:5.2f} -> overhead "
               f"{(py_out - cpp_out) * 1e6:5.2f} µs/step (median)")
-        print(f"  CPU time (unaffected by waiting for a core): C++ loop {cpp_cpu * 1e6:.1f}, Python "
+        print(f"  CPU time (not counting waits for a core): C++ loop {cpp_cpu * 1e6:.1f}, Python "
               f"loop {py_cpu * 1e6:.1f} µs/step -> {(py_cpu - cpp_cpu) * 1e6:.2f} µs/step")
         print(f"  per step, Python env.step() minus the C++ step inside it: median "
-              f"{np.median(each) * 1e6:.2f} µs, 10th-90th percentile {np.percentile(each, 10) * 1e6:.2f}"
+              f"{np.median(each) * 1e6:.2f} µs, 10th-90th percentile "
+              f"{np.percentile(each, 10) * 1e6:.2f}"
               f"-{np.percentile(each, 90) * 1e6:.2f} µs")
 
     # Vector env: C++ vector steps vs cradle.VectorEnv.step (which also copies the batch), in
@@ -128,7 +129,8 @@ def main():
         steps = block * args.envs
         print(f"vector env ({args.envs} envs, {vec.threads} threads, {len(cpp)} blocks of {block} "
               f"steps): C++ {steps / np.median(cpp):6.0f} env steps/s, Python "
-              f"{steps / np.median(py):6.0f} env steps/s; Python/C++ throughput {np.median(cpp / py):.3f} "
+              f"{steps / np.median(py):6.0f} env steps/s; Python/C++ throughput "
+              f"{np.median(cpp / py):.3f} "
               f"(median of blocks); {(np.median(py) - np.median(cpp)) / block * 1e6:.1f} µs more "
               f"per vector step; CPU time Python/C++ {np.sum(py_cpu) / np.sum(cpp_cpu):.3f}")
         print(f"  within the Python loop: time inside the C++ vector step / loop time "

@@ -264,4 +264,6 @@ def register_gymnasium_envs():
     for env_id in ENV_IDS:
         full_id = f"cradle/{env_id}-v0"
         if full_id not in _gymnasium.registry:
-            _gymnasium.register(id=full_id, entry_point="cradle.env:make", kwargs={"env_id": env_id})
+            _gymnasium.register(
+                id=full_id, entry_point="cradle.env:make", kwargs={"env_id": env_id}
+            )

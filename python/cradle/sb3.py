@@ -39,7 +39,9 @@ class SB3VecEnv(_SB3VecEnv):
                 info["terminal_observation"] = infos["final_obs"][i]
                 info["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
             else:
-                info = {k: v[i] for k, v in infos.items() if not k.startswith("_") and k not in _SKIP}
+                info = {
+                    k: v[i] for k, v in infos.items() if not k.startswith("_") and k not in _SKIP
+                }
             out.append(info)
         return out
 

@@ -211,7 +211,10 @@ def from_core_box(description):
 
 def from_core_dict(description):
     """A Dict space from the extension's [(key, shape, dtype, low, high), ...] list."""
-    return make_dict((key, from_core_box((shape, dtype, low, high))) for key, shape, dtype, low, high in description)
+    return make_dict(
+        (key, from_core_box((shape, dtype, low, high)))
+        for key, shape, dtype, low, high in description
+    )
 
 
 def batch_space(space, n):

@@ -24,9 +24,18 @@ namespace {
 
 using Actions = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// Numpy object array of n entries (Gymnasium's vector infos for non-numeric values).
-py::array object_array(py::ssize_t n) {
-  return py::module_::import("numpy").attr("empty")(n, py::arg("dtype") = "object");
+// Numpy object array holding `items` (Gymnasium's vector infos for non-numeric values); None
+// for null items. Filled through its data pointer: numpy zero-fills object arrays (null slots).
+py::array object_array(std::vector<py::object> items) {
+  const std::vector<py::ssize_t> shape = {static_cast<py::ssize_t>(items.size())};
+  py::array out(py::dtype("O"), shape);
+  auto** slots = static_cast<PyObject**>(out.mutable_data());
+  for (size_t i = 0; i < items.size(); ++i) {
+    PyObject* value = items[i] ? items[i].release().ptr() : Py_NewRef(Py_None);
+    Py_XDECREF(slots[i]);
+    slots[i] = value;
+  }
+  return out;
 }
 
 }  // namespace
@@ -90,7 +99,7 @@ class PyVecEnv {
     py::dict info;
     if (same_step_) {
       // The ended envs' last observation and info, then their reset, then the batch.
-      py::array final_obs = object_array(envs), final_info = object_array(envs);
+      std::vector<py::object> final_obs(envs), final_info(envs);
       py::array_t<bool> mask(envs);
       for (int i = 0; i < envs; ++i) {
         const bool ended = terminated.at(i) || truncated.at(i);
@@ -101,8 +110,8 @@ class PyVecEnv {
             o[entries_[k].key.c_str()] =
                 copy_array(entries_[k], vec_->observation(i).bytes(static_cast<int>(k)));
           }
-          final_obs[py::int_(i)] = o;
-          final_info[py::int_(i)] = info_dict(behavior_, vec_->info(i));
+          final_obs[i] = o;
+          final_info[i] = info_dict(behavior_, vec_->info(i));
         }
       }
       {
@@ -111,9 +120,9 @@ class PyVecEnv {
         gather();
       }
       info = infos();
-      info["final_obs"] = final_obs;
+      info["final_obs"] = object_array(std::move(final_obs));
       info["_final_obs"] = mask;
-      info["final_info"] = final_info;
+      info["final_info"] = object_array(std::move(final_info));
       info["_final_info"] = mask;
     } else {
       info = infos();
@@ -193,13 +202,13 @@ class PyVecEnv {
       out[("_" + std::string(key)).c_str()] = all;
     };
     if (behavior_ == Behavior::kSelfTouch) {
-      py::array right = object_array(envs), left = object_array(envs);
+      std::vector<py::object> right(envs), left(envs);
       for (int i = 0; i < envs; ++i) {
-        right[py::int_(i)] = py::cast(vec_->info(i).right_hand_touches);
-        left[py::int_(i)] = py::cast(vec_->info(i).left_hand_touches);
+        right[i] = py::cast(vec_->info(i).right_hand_touches);
+        left[i] = py::cast(vec_->info(i).left_hand_touches);
       }
-      put("right_hand_touches", right);
-      put("left_hand_touches", left);
+      put("right_hand_touches", object_array(std::move(right)));
+      put("left_hand_touches", object_array(std::move(left)));
     } else if (behavior_ == Behavior::kHandRegard) {
       const char* names[] = {"right_eye_right_hand", "right_eye_left_hand", "left_eye_right_hand",
                              "left_eye_left_hand"};

@@ -40,7 +40,8 @@ def test_same_step_autoreset_and_thread_independence(make_config):
         rng = np.random.default_rng(0)
         seen = [obs["observation"].copy()]
         for t in range(3):
-            actions = rng.uniform(vec.single_action_space.low, vec.single_action_space.high, (3, 30))
+            space = vec.single_action_space
+            actions = rng.uniform(space.low, space.high, (3, 30))
             obs, rewards, terminated, truncated, infos = vec.step(actions)
             seen.append(obs["observation"].copy())
             if t == 1:
