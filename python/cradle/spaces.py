@@ -57,17 +57,17 @@ class Box(Space):
             shape = np.broadcast(np.asarray(low), np.asarray(high)).shape
         shape = tuple(int(s) for s in shape)
         super().__init__(shape, dtype, seed)
-        bound_type = dtype if np.issubdtype(dtype, np.integer) else np.float64
         low = np.broadcast_to(np.asarray(low, dtype=np.float64), shape)
         high = np.broadcast_to(np.asarray(high, dtype=np.float64), shape)
-        if np.issubdtype(dtype, np.integer):
+        self.bounded_below = np.isfinite(low)
+        self.bounded_above = np.isfinite(high)
+        if np.issubdtype(dtype, np.integer):  # bounds within the integer type, as Gymnasium
             info = np.iinfo(dtype)
             low = np.clip(low, info.min, info.max)
             high = np.clip(high, info.min, info.max)
-        self.low = low.astype(dtype if dtype.kind == "f" else bound_type)
-        self.high = high.astype(dtype if dtype.kind == "f" else bound_type)
-        self.bounded_below = np.isfinite(low)
-        self.bounded_above = np.isfinite(high)
+        # Bounds in the space's dtype (float32 action bounds are rounded, as Gymnasium's).
+        self.low = low.astype(dtype)
+        self.high = high.astype(dtype)
 
     def is_bounded(self, manner="both"):
         below, above = bool(np.all(self.bounded_below)), bool(np.all(self.bounded_above))
