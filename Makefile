@@ -9,7 +9,7 @@ EPISODES ?= 2
 INTRINSIC ?= body_part_novelty
 RESULTS ?= results/make_run
 
-.PHONY: all deps configure build run test install format clean
+.PHONY: all deps configure build run test install install-python format clean
 
 all: build
 
@@ -35,6 +35,14 @@ test: build
 
 install: build
 	@cmake --install $(BUILD_DIR)
+
+# The Python package `cradle` into Debian python3's user site-packages (override PYTHON_PREFIX to
+# install elsewhere, then put that folder on PYTHONPATH).
+PYTHON ?= /usr/bin/python3
+PYTHON_PREFIX ?= $(shell $(PYTHON) -c 'import site; print(site.getusersitepackages())')
+install-python: build
+	@cmake --install $(BUILD_DIR) --component python --prefix $(PYTHON_PREFIX)
+	@echo "installed: $(PYTHON_PREFIX)/cradle (try: $(PYTHON) -c 'import cradle')"
 
 format:
 	@find src tests bench -name '*.cc' -o -name '*.h' | xargs clang-format -i

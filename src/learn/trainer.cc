@@ -129,6 +129,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   lo.reward_hook = [&](const VecEnv& env, std::span<const double> actions,
                        std::span<double> rewards) {
     if (reward) reward->compute(env, actions, rewards);
+    if (options.reward_hook) options.reward_hook(env, actions, rewards);
     for (int i = 0; i < env.num_envs(); ++i) {
       if (env.terminated()[i] || env.truncated()[i]) {
         const envs::Info& info = env.info(i);

@@ -36,6 +36,9 @@ struct TrainOptions {
   // <save_dir>/random_baseline, to report the two scores side by side.
   bool compare_random = false;
   bool progress_bar = true;
+  // Extra reward terms (e.g. Python callables), called after the named intrinsic rewards with
+  // the same arguments; they may add to the rewards in place.
+  RewardHook reward_hook;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
 };

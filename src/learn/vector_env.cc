@@ -103,6 +103,14 @@ void ThreadedVecEnv::step(std::span<const double> actions) {
   });
 }
 
+void ThreadedVecEnv::reset_ended() {
+  pool_.parallel_for(num_envs(), [this](int i) {
+    if (!ended_[i]) return;
+    envs_[i]->reset();
+    ended_[i] = 0;
+  });
+}
+
 int ThreadedVecEnv::key_size(int key_index) const {
   return observation_space().entries.at(key_index).second.size();
 }

@@ -38,6 +38,10 @@ class ThreadedVecEnv final : public VecEnv {
   const Box& action_space() const override { return envs_[0]->action_space(); }
   void reset(std::uint64_t seed) override;
   void step(std::span<const double> actions) override;
+  // Same-step autoreset (Stable-Baselines3's convention), after step(): resets now every env
+  // whose episode ended in that call, so the next step() steps it instead of resetting it. The
+  // rewards and flags of that call stay as they were; observation(i) becomes the new episode's.
+  void reset_ended();
 
   const envs::ObservationBuffers& observation(int env) const override {
     return envs_[env]->observation();

@@ -136,6 +136,33 @@ TEST(ThreadedVecEnv, NextStepAutoreset) {
   }
 }
 
+// reset_ended (SB3's same-step autoreset): the ending call's flags stay, the env starts its next
+// episode at once (the same observation next-step autoreset gives one call later), and the next
+// call steps it.
+TEST(ThreadedVecEnv, ResetEndedResetsInTheSameStep) {
+  const int max_steps = 3;
+  const auto assets = envs::make_assets(self_touch(max_steps));
+  const auto vec = vector_of(assets, 2, 2, 7);
+  vec->reset(7);
+  std::vector<double> actions(2 * vec->action_space().size(), 0.0);
+  for (int t = 1; t <= max_steps; ++t) vec->step(actions);
+  vec->reset_ended();
+  for (int i = 0; i < 2; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(vec->truncated()[i], 1);
+    EXPECT_EQ(static_cast<envs::BabyBenchEnv&>(vec->env(i)).episode_steps(), 0);
+    envs::BabyBenchEnv ref(assets);
+    ref.reset(ThreadedVecEnv::env_seed(7, i));
+    ref.reset();
+    EXPECT_TRUE(same_observation(vec->observation(i), ref.observation()));
+  }
+  vec->step(actions);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(static_cast<envs::BabyBenchEnv&>(vec->env(i)).episode_steps(), 1);
+    EXPECT_EQ(vec->truncated()[i], 0);
+  }
+}
+
 // Everything a step produces, for every env, as bytes.
 std::vector<std::byte> snapshot(const ThreadedVecEnv& vec) {
   std::vector<std::byte> out;

@@ -1,0 +1,56 @@
+"""Shared by the example scripts: the reference's flags, finding the package and the configs, and
+PPO from Stable-Baselines3 when it is installed, Cradle's C++ PPO otherwise."""
+
+import argparse
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+try:
+    import cradle  # noqa: F401
+except ImportError:  # run from a checkout without PYTHONPATH: use the build tree's package
+    sys.path.insert(0, os.path.join(ROOT, "build", "python"))
+    import cradle  # noqa: F401
+
+try:
+    import stable_baselines3
+except ImportError:
+    stable_baselines3 = None
+
+
+def parse_args(description, default_config):
+    """The reference examples' flags: --config and --train_for."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--config", default=default_config, type=str,
+                        help="the configuration file to set up the environment")
+    parser.add_argument("--train_for", default=10000, type=int,
+                        help="total timesteps of training")
+    args = parser.parse_args()
+    # The reference runs from its repository root; configs/ here is found from anywhere.
+    if not os.path.exists(args.config) and os.path.exists(os.path.join(ROOT, args.config)):
+        args.config = os.path.join(ROOT, args.config)
+    return args
+
+
+def train_ppo(config, wrapper_class, reward_fn, train_for):
+    """PPO for train_for steps on the intrinsic reward. With SB3: its PPO("MultiInputPolicy") with
+    all defaults on the wrapped env (as the reference), model saved to <save_dir>/model.zip.
+    Without SB3: Cradle's PPO (SB3's defaults, C++), reward_fn passed as a Python intrinsic
+    reward, checkpoint under <save_dir>/checkpoints/."""
+    save_dir = cradle.config_dict(config)["save_dir"]
+    if stable_baselines3 is not None:
+        env = wrapper_class(cradle.make_env(config, training=True))
+        env.reset()
+        model = stable_baselines3.PPO("MultiInputPolicy", env, verbose=1)
+        model.learn(total_timesteps=train_for)
+        model.save(os.path.join(save_dir, "model"))
+        env.close()
+        print(f"SB3 PPO model saved to {os.path.join(save_dir, 'model.zip')}")
+        return
+    print("stable_baselines3 is not installed: training with Cradle's PPO (C++)")
+    result = cradle.train(config, algo="ppo", intrinsic=[reward_fn], steps=train_for, envs=1,
+                          eval_episodes=0)
+    print(f"trained {result['steps']} steps at {result['steps_per_second']:.0f} steps/s; "
+          f"checkpoint {result['checkpoint']}; training score {result['training_score']}")

@@ -1,0 +1,49 @@
+"""Cradle from Python: BabyBench envs stepped in C++, Gymnasium-shaped.
+
+    import cradle
+    env = cradle.make_env("configs/config_selftouch.yml")      # or a dict of BabyBench keys
+    obs, info = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+See README.md, section "Python".
+"""
+
+from . import spaces
+from ._cradle import __version__
+from .env import (
+    ENV_IDS,
+    BabyBenchEnv,
+    config_dict,
+    load_config,
+    make,
+    make_env,
+    register_gymnasium_envs,
+)
+from .spaces import HAS_GYMNASIUM
+from .training import evaluate, load_policy, load_training_log, train, training_score
+from .vector import VectorEnv
+from .wrappers import ActionWrapper, ObservationWrapper, RewardWrapper, Wrapper
+
+register_gymnasium_envs()
+
+__all__ = [
+    "ENV_IDS",
+    "HAS_GYMNASIUM",
+    "ActionWrapper",
+    "BabyBenchEnv",
+    "ObservationWrapper",
+    "RewardWrapper",
+    "VectorEnv",
+    "Wrapper",
+    "__version__",
+    "config_dict",
+    "evaluate",
+    "load_config",
+    "load_policy",
+    "load_training_log",
+    "make",
+    "make_env",
+    "spaces",
+    "train",
+    "training_score",
+]

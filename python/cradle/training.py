@@ -1,0 +1,193 @@
+"""Training, evaluation and training logs from Python, on the C++ learners and evaluation."""
+
+import inspect
+import json
+import os
+import pickle
+
+from . import _cradle
+from .env import load_config
+
+# Per behaviour, the keys of a reference training.pkl entry, in the reference's order.
+_REFERENCE_KEYS = {
+    "self_touch": ["right_hand_touches", "left_hand_touches", "steps"],
+    "hand_regard": [
+        "right_eye_right_hand",
+        "right_eye_left_hand",
+        "left_eye_right_hand",
+        "left_eye_left_hand",
+        "steps",
+    ],
+    "none": ["steps"],
+}
+# Cradle's extra keys in training.jsonl (kept with extras=True).
+_EXTRA_KEYS = ["right_eye_either_hand", "left_eye_either_hand", "score", "wall_time"]
+
+
+def _wants_full_call(fn):
+    """True when fn takes (obs, action, info); False when it takes only (obs)."""
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return True
+    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    if any(p.kind == p.VAR_POSITIONAL for p in params):
+        return True
+    return len(positional) >= 3
+
+
+def _split_intrinsic(intrinsic):
+    """(C++ spec "name:w,...", [(callable, weight, full call)]) from the intrinsic list."""
+    if intrinsic is None:
+        return "", []
+    if isinstance(intrinsic, str) or callable(intrinsic):
+        intrinsic = [intrinsic]
+    names, terms = [], []
+    for item in intrinsic:
+        weight = 1.0
+        if isinstance(item, tuple):
+            if len(item) != 2:
+                raise ValueError(f"intrinsic term {item!r}: expected (name or callable, weight)")
+            item, weight = item
+        if isinstance(item, str):
+            names.append(item if weight == 1.0 else f"{item}:{float(weight)!r}")
+        elif callable(item):
+            terms.append((item, float(weight), _wants_full_call(item)))
+        else:
+            raise ValueError(f"intrinsic term {item!r}: expected a reward name or a callable")
+    return ",".join(names), terms
+
+
+def train(
+    config,
+    algo="ppo",
+    intrinsic=("body_part_novelty",),
+    steps=100_000,
+    envs=2,
+    threads=0,
+    seed=0,
+    resume=False,
+    randomize_start=False,
+    checkpoint_every=100_000,
+    hyperparameters=None,
+    eval_episodes=2,
+    eval_duration=1000,
+    eval_render=True,
+    compare_random=False,
+    progress_bar=True,
+):
+    """Trains a policy with Cradle's C++ learners, exactly as `cradle train` does (same options,
+    same outputs under save_dir: training log, logs/progress.csv, checkpoints/, plots/, the
+    evaluation of the trained policy).
+
+    intrinsic: a list of reward terms, each a registered name ("touch_count", "saliency",
+      "body_part_novelty", "rnd", "icm", "disagreement", "hand_visibility"; "name:weight" also
+      works), a Python callable, or a (name or callable, weight) pair; [] trains on the env reward
+      (0 for BabyBench) only. A callable is called once per env and vector step as fn(obs) or
+      fn(obs, action, info) and returns a float; obs holds read-only views of the env's buffers,
+      valid only during the call (copy what you keep). The C++ loop takes the GIL once per vector
+      step for these calls; their cost is the Python calls themselves (about a microsecond each
+      plus the callable's own time, next to an env step of about 0.4 ms).
+    hyperparameters: {name: value} overrides of the algorithm's hyperparameters (as --hp).
+
+    Returns a dict: steps, seconds, steps_per_second, training_score, checkpoint, evaluation
+    (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
+    KeyboardInterrupt.
+    """
+    spec, terms = _split_intrinsic(intrinsic)
+    hp = {str(k): str(v) for k, v in (hyperparameters or {}).items()}
+    result = _cradle.train(
+        load_config(config), algo, spec, int(steps), int(envs), int(threads), int(seed),
+        bool(resume), bool(randomize_start), int(checkpoint_every), hp, int(eval_episodes),
+        int(eval_duration), bool(eval_render), bool(compare_random), bool(progress_bar), terms,
+    )
+    for key in ("evaluation", "random_evaluation"):
+        if result[key] is not None:
+            result[key] = json.loads(result[key])
+    return result
+
+
+def load_policy(config, checkpoint):
+    """A trained checkpoint's deterministic policy, for evaluate(policy=...)."""
+    return _cradle.load_policy(load_config(config), os.fspath(checkpoint))
+
+
+def evaluate(config, episodes=10, duration=1000, render=True, seed=0, policy=None,
+             video_format="mp4", quiet=False):
+    """Runs the evaluation as `cradle evaluate`: prints the training-log score, runs `episodes`
+    episodes of `duration` steps, writes trajectories/, videos/, evaluation.json and plots/ under
+    save_dir, and returns the report as a dict.
+
+    policy: None (uniform random actions), a checkpoint path, a load_policy() result, or a
+    callable fn(obs) -> action (fresh observation arrays; called with the GIL for each step).
+    """
+    if video_format not in ("mp4", "avi"):
+        raise ValueError("video_format must be 'mp4' or 'avi'")
+    if isinstance(policy, os.PathLike):
+        policy = os.fspath(policy)
+    report = _cradle.evaluate(load_config(config), int(episodes), int(duration), bool(render),
+                              int(seed), "." + video_format, bool(quiet), policy)
+    return json.loads(report)
+
+
+def _log_file(path):
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        for candidate in ("logs/training.jsonl", "training.jsonl", "logs/training.pkl",
+                          "training.pkl"):
+            if os.path.exists(os.path.join(path, candidate)):
+                return os.path.join(path, candidate)
+        raise FileNotFoundError(f"no training.jsonl or training.pkl under '{path}'")
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"training log '{path}' does not exist")
+    return path
+
+
+def load_training_log(path, extras=False):
+    """The reference's training.pkl structure (a list of dicts, one per recorded episode) from
+    Cradle's logs/training.jsonl, a save_dir, or a reference training.pkl.
+
+    Entries have the reference's keys in its order: self-touch {'right_hand_touches': [geom ids],
+    'left_hand_touches': [...], 'steps': n}, hand regard the four eye-hand counts and 'steps',
+    none {'steps': n}. extras=True keeps Cradle's additional keys ('score', 'wall_time',
+    '*_either_hand'). The first entry is the 0-step one the first reset records, as in the
+    reference.
+    """
+    file = _log_file(path)
+    if file.endswith(".pkl"):
+        with open(file, "rb") as f:
+            return pickle.load(f)
+    entries = []
+    with open(file, encoding="utf-8") as f:
+        lines = f.read().split("\n")
+    for number, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            entries.append(json.loads(line))
+        except json.JSONDecodeError:
+            if number == len(lines):  # an unterminated last line (a crash mid-write)
+                break
+            raise ValueError(f"{file}:{number}: not a JSON line") from None
+    out = []
+    for entry in entries:
+        if "right_hand_touches" in entry:
+            keys = _REFERENCE_KEYS["self_touch"]
+        elif "right_eye_right_hand" in entry:
+            keys = _REFERENCE_KEYS["hand_regard"]
+        else:
+            keys = _REFERENCE_KEYS["none"]
+        ordered = {k: entry[k] for k in keys if k in entry}
+        if extras:
+            ordered.update({k: v for k, v in entry.items() if k not in ordered})
+        out.append(ordered)
+    return out
+
+
+def training_score(log, behavior):
+    """The reference's preliminary training score of a log (a load_training_log() list or a path):
+    self-touch coverage over the last 10,000 episodes, hand regard the mean in-view fraction;
+    None for behavior "none"."""
+    if not isinstance(log, list):
+        log = load_training_log(log)
+    return _cradle.training_score(behavior, json.dumps(log))

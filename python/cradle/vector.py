@@ -1,0 +1,108 @@
+"""cradle.VectorEnv: N BabyBench envs stepped together by C++ threads, with Gymnasium 1.x vector
+semantics: batched numpy observations (num_envs, ...), reward/terminated/truncated arrays, infos as
+a dict of arrays with "_key" masks, and next-step autoreset (an env whose episode ended in one
+step() is reset by the next, which reports reward 0 and the new episode's first observation).
+
+Every step returns fresh arrays. The envs share one compiled model; env i is seeded with the i-th
+seed derived from reset(seed=...), so a seed gives the same batches for any number of threads.
+"""
+
+import numbers
+
+import numpy as np
+
+from . import _cradle
+from . import spaces
+from .env import _gymnasium, load_config
+
+if _gymnasium is not None:
+    import gymnasium.vector as _gym_vector
+
+    _VectorBase = _gym_vector.VectorEnv
+    _NEXT_STEP = getattr(_gym_vector, "AutoresetMode", None)
+    _NEXT_STEP = _NEXT_STEP.NEXT_STEP if _NEXT_STEP is not None else "next_step"
+    _SAME_STEP = getattr(_gym_vector, "AutoresetMode", None)
+    _SAME_STEP = _SAME_STEP.SAME_STEP if _SAME_STEP is not None else "same_step"
+else:
+    _VectorBase = object
+    _NEXT_STEP, _SAME_STEP = "next_step", "same_step"
+
+
+class VectorEnv(_VectorBase):
+    """num_envs BabyBench envs of one config on a C++ thread pool.
+
+    Args:
+      config: dict, YAML path or parsed config.
+      num_envs: number of envs.
+      threads: pool participants (0: one per env, at most the cores; 1: the calling thread only).
+      training: prepare save_dir and log every episode of every env in one training log.
+      seed: seed used by reset() without a seed (and of the seeds it draws afterwards).
+      autoreset_mode: "next_step" (Gymnasium's default) or "same_step" (an ended env is reset in
+        the same call; its last observation and info are in infos["final_obs"/"final_info"]).
+    """
+
+    def __init__(self, config, num_envs, threads=0, training=False, seed=0,
+                 autoreset_mode="next_step"):
+        if autoreset_mode not in ("next_step", "same_step"):
+            raise ValueError("autoreset_mode must be 'next_step' or 'same_step'")
+        if not isinstance(num_envs, numbers.Integral) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, not {num_envs!r}")
+        self._config = load_config(config)
+        self._core = _cradle.VecEnv(self._config, int(num_envs), int(threads), bool(training),
+                                    int(seed), autoreset_mode == "same_step")
+        self.num_envs = int(num_envs)
+        self.single_observation_space = spaces.from_core_dict(self._core.observation_space)
+        self.single_action_space = spaces.from_core_box(self._core.action_space)
+        self.observation_space = spaces.batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = spaces.batch_space(self.single_action_space, self.num_envs)
+        self.metadata = {
+            "autoreset_mode": _NEXT_STEP if autoreset_mode == "next_step" else _SAME_STEP,
+            "render_modes": [],
+        }
+        self.render_mode = None
+        self.spec = None
+        self.closed = False
+        self._seeds = np.random.default_rng(seed)
+        self._np_random = None
+
+    @property
+    def np_random(self):
+        if self._np_random is None:
+            self._np_random = np.random.default_rng()
+        return self._np_random
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def threads(self):
+        return self._core.threads
+
+    def reset(self, *, seed=None, options=None):
+        """Resets every env: (observations, infos). Env i gets the i-th seed derived from `seed`
+        (an int; None: the next seed of the vector's own generator)."""
+        if seed is None:
+            seed = int(self._seeds.integers(2**63))
+        elif not isinstance(seed, numbers.Integral) or seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
+        else:
+            self._np_random = np.random.default_rng(seed)
+        return self._core.reset(int(seed))
+
+    def step(self, actions):
+        """actions: (num_envs, action dim). Returns (observations, rewards, terminated, truncated,
+        infos); the C++ envs step in parallel with the GIL released."""
+        return self._core.step(actions)
+
+    def render(self):
+        return None
+
+    def close(self, **kwargs):
+        """Records the envs' last episodes in the training log (training mode)."""
+        if not self.closed:
+            self._core.close()
+            self.closed = True
+
+    def __repr__(self):
+        return f"<cradle.VectorEnv num_envs={self.num_envs} behavior={self._config.behavior!r}>"

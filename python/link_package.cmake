@@ -1,0 +1,11 @@
+# Symlinks python/cradle/*.py and configs/*.yml into the build tree's package folder (DST).
+file(GLOB py_files ${SRC}/python/cradle/*.py)
+foreach(f ${py_files})
+  get_filename_component(name ${f} NAME)
+  file(CREATE_LINK ${f} ${DST}/${name} SYMBOLIC)
+endforeach()
+file(GLOB config_files ${SRC}/configs/*.yml)
+foreach(f ${config_files})
+  get_filename_component(name ${f} NAME)
+  file(CREATE_LINK ${f} ${DST}/configs/${name} SYMBOLIC)
+endforeach()

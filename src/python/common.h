@@ -1,0 +1,51 @@
+// Shared pieces of the `_cradle` extension module: numpy conversion of observation buffers and
+// spaces, info dicts, and the registration functions of each binding file.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "core/spaces.h"
+#include "envs/env.h"
+
+namespace cradle::python {
+
+namespace py = pybind11;
+
+// What is needed to turn one observation entry into a numpy array without looking up its Box.
+struct Entry {
+  std::string key;
+  py::dtype dtype;
+  std::vector<py::ssize_t> shape;
+  size_t bytes = 0;
+};
+std::vector<Entry> entries_of(const DictSpace& space);
+
+// A fresh array holding a copy of `data`.
+py::array copy_array(const Entry& entry, std::span<const std::byte> data);
+// A read-only array over `data` (no copy) that keeps `owner` alive.
+py::array view_array(const Entry& entry, std::span<const std::byte> data, py::handle owner);
+// A read-only 1-D float64 array over `n` values that keeps `owner` alive.
+py::array view_doubles(const double* data, py::ssize_t n, py::handle owner);
+
+// The reference's info dict of a behaviour (Cradle's extra hand-regard keys included).
+py::dict info_dict(Behavior behavior, const envs::Info& info);
+
+// A space as Python data: [(key, shape tuple, dtype name, low array, high array), ...].
+py::tuple box_tuple(const Box& box);
+py::list space_list(const DictSpace& space);
+
+// Parses a config from YAML text (dicts arrive as JSON, a YAML subset); UserError -> ValueError.
+Config config_from_text(const std::string& text, const std::string& source);
+
+void bind_env(py::module_& m);
+void bind_learn(py::module_& m);
+
+}  // namespace cradle::python

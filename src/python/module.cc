@@ -1,0 +1,138 @@
+// `_cradle`: the extension module behind the Python package `cradle` (python/cradle/). It holds
+// only what must be C++ (envs, vector envs, learners, evaluation); the Gymnasium-shaped classes
+// around it are plain Python.
+#include <pybind11/operators.h>
+
+#include <cstring>
+#include <string_view>
+
+#include "core/error.h"
+#include "python/common.h"
+
+namespace cradle::python {
+
+std::vector<Entry> entries_of(const DictSpace& space) {
+  std::vector<Entry> out;
+  for (const auto& [key, box] : space.entries) {
+    Entry e{.key = key, .dtype = py::dtype(std::string(dtype_name(box.dtype)))};
+    for (int d : box.shape) e.shape.push_back(d);
+    e.bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+py::array copy_array(const Entry& entry, std::span<const std::byte> data) {
+  py::array out(entry.dtype, entry.shape);
+  std::memcpy(out.mutable_data(), data.data(), entry.bytes);
+  return out;
+}
+
+namespace {
+
+// Clears numpy's WRITEABLE flag: views of C++ buffers must not be written from Python.
+void make_read_only(py::array& a) {
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+}
+
+}  // namespace
+
+py::array view_array(const Entry& entry, std::span<const std::byte> data, py::handle owner) {
+  py::array out(entry.dtype, entry.shape, {}, data.data(), owner);
+  make_read_only(out);
+  return out;
+}
+
+py::array view_doubles(const double* data, py::ssize_t n, py::handle owner) {
+  py::array out(py::dtype::of<double>(), {n}, {}, data, owner);
+  make_read_only(out);
+  return out;
+}
+
+py::dict info_dict(Behavior behavior, const envs::Info& info) {
+  py::dict d;
+  if (behavior == Behavior::kSelfTouch) {
+    d["right_hand_touches"] = py::cast(info.right_hand_touches);
+    d["left_hand_touches"] = py::cast(info.left_hand_touches);
+  } else if (behavior == Behavior::kHandRegard) {
+    d["right_eye_right_hand"] = info.hand_regard[0];
+    d["right_eye_left_hand"] = info.hand_regard[1];
+    d["left_eye_right_hand"] = info.hand_regard[2];
+    d["left_eye_left_hand"] = info.hand_regard[3];
+    d["right_eye_either_hand"] = info.hand_regard_either[0];
+    d["left_eye_either_hand"] = info.hand_regard_either[1];
+  }
+  d["steps"] = info.steps;
+  return d;
+}
+
+py::tuple box_tuple(const Box& box) {
+  py::tuple shape(box.shape.size());
+  for (size_t i = 0; i < box.shape.size(); ++i) shape[i] = box.shape[i];
+  return py::make_tuple(shape, std::string(dtype_name(box.dtype)), py::array(py::cast(box.low)),
+                        py::array(py::cast(box.high)));
+}
+
+py::list space_list(const DictSpace& space) {
+  py::list out;
+  for (const auto& [key, box] : space.entries) {
+    py::tuple b = box_tuple(box);
+    out.append(py::make_tuple(key, b[0], b[1], b[2], b[3]));
+  }
+  return out;
+}
+
+Config config_from_text(const std::string& text, const std::string& source) {
+  return parse_config(text, source);
+}
+
+}  // namespace cradle::python
+
+namespace py = pybind11;
+using cradle::Config;
+
+PYBIND11_MODULE(_cradle, m) {
+  m.doc() =
+      "Cradle's C++ core (envs, vector envs, learners, evaluation); use the `cradle` package.";
+  m.attr("__version__") = CRADLE_VERSION;
+
+  // User errors become ValueError with the one-line message; a missing file FileNotFoundError.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const cradle::UserError& e) {
+      const std::string_view what = e.what();
+      if (what.find("no such file") != std::string_view::npos ||
+          what.find("does not exist") != std::string_view::npos) {
+        PyErr_SetString(PyExc_FileNotFoundError, e.what());
+      } else {
+        PyErr_SetString(PyExc_ValueError, e.what());
+      }
+    }
+  });
+
+  py::class_<Config>(m, "Config", "A parsed BabyBench config (see cradle.make_env).")
+      .def_readonly("save_dir", &Config::save_dir)
+      .def_readonly("max_episode_steps", &Config::max_episode_steps)
+      .def_readonly("frame_skip", &Config::frame_skip)
+      .def_readonly("render_size", &Config::render_size)
+      .def_property_readonly(
+          "behavior",
+          [](const Config& c) { return std::string(cradle::behavior_name(c.behavior)); })
+      .def("to_yaml", [](const Config& c) { return cradle::to_yaml(c); })
+      .def("to_json", [](const Config& c) { return cradle::to_json(c).dump(); })
+      .def(py::self == py::self);
+  m.def("parse_config", &cradle::python::config_from_text, py::arg("text"), py::arg("source"),
+        "Parses YAML (or JSON) config text; `source` names it in error messages.");
+  m.def(
+      "load_config", [](const std::string& path) { return cradle::load_config(path); },
+      py::arg("path"), "Reads and parses a YAML config file.");
+  m.def("default_config", &cradle::default_config);
+  m.def("config_keys", [] {
+    const auto keys = cradle::config_keys();
+    return std::vector<std::string>(keys.begin(), keys.end());
+  });
+
+  cradle::python::bind_env(m);
+  cradle::python::bind_learn(m);
+}
