@@ -1,10 +1,10 @@
 // `cradle illustrate --env reach|standup|selfbody|catch --train_for N --test_for M --algorithm
 // PPO|SAC|TD3|DDPG|A2C [--save_every K] [--save_model NAME] [--load_model PATH] [--use_muscles]
-// [--render_video] [--envs K] [--seed S] [--hp name=value]`: the reference's illustrations.py.
-// Trains a policy on a MIMo sample env (checkpoints models/<env>/<name>/model_<k>.ckpt every
-// save_every steps, progress.csv), then runs test_for steps with it (or with random actions when
-// there is no model), optionally filming each episode, and prints the success rate and the mean
-// return per episode.
+// [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]`: the reference's
+// illustrations.py. Trains a policy on a MIMo sample env (checkpoints
+// models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv), then runs test_for
+// steps with it (or with random actions when there is no model), optionally filming each episode,
+// and prints the success rate and the mean return per episode.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -42,6 +42,7 @@ struct IllustrateOptions {
   std::string save_model = "model";
   bool render_video = false;
   bool use_muscles = false;
+  bool stochastic = false;
   int envs = 1;
   std::uint64_t seed = 0;
   std::vector<std::string> hp;
@@ -148,6 +149,7 @@ void run(const IllustrateOptions& o) {
     const long total = first + o.train_for;
     long next_save = first + o.save_every;
     int saved = 0;
+    long saved_at = first;
     long last_report = first;
     const auto start = Clock::now();
     std::printf("training %s on %s for %ld steps (%d envs) -> %s\n", algorithm.c_str(), id.c_str(),
@@ -166,6 +168,7 @@ void run(const IllustrateOptions& o) {
       csv.flush();
       if (s.steps >= next_save) {
         learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
+        saved_at = s.steps;
         next_save += o.save_every;
       }
       if (s.steps - last_report >= std::max<long>(o.train_for / 20, 1) || s.steps >= total) {
@@ -177,14 +180,14 @@ void run(const IllustrateOptions& o) {
       }
       return true;
     });
-    if (learner->steps() > (next_save - o.save_every)) {
+    if (learner->steps() > saved_at) {
       learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
     }
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
   }
-  vec.reset();
+  // The vector stays alive: the learner keeps a reference to it.
 
   // Testing: one env, the policy's deterministic action (random actions without a model).
   if (o.test_for == 0) return;
@@ -213,10 +216,12 @@ void run(const IllustrateOptions& o) {
   Episode current;
   start_video(0);
   std::printf("testing %s for %ld steps with %s\n", id.c_str(), o.test_for,
-              learner ? "the trained policy" : "random actions");
+              !learner       ? "random actions"
+              : o.stochastic ? "the trained policy (sampled actions)"
+                             : "the trained policy");
   for (long t = 0; t < o.test_for; ++t) {
     if (learner) {
-      learner->act(env->observation(), action, /*deterministic=*/true);
+      learner->act(env->observation(), action, /*deterministic=*/!o.stochastic);
     } else {
       for (size_t k = 0; k < action.size(); ++k)
         action[k] = rng.uniform(space.low[k], space.high[k]);
@@ -273,6 +278,8 @@ void register_illustrate(CLI::App& app) {
   cmd->add_flag("--render_video", o->render_video, "Film every test episode (episode_<i>.mp4)");
   cmd->add_flag("--use_muscles,--use_muscle", o->use_muscles,
                 "Muscle actuation instead of spring-damper motors");
+  cmd->add_flag("--stochastic", o->stochastic,
+                "Test with sampled actions (SB3's predict default) instead of the policy's mean");
   cmd->add_option("--envs", o->envs, "Parallel training envs (one thread each)");
   cmd->add_option("--seed", o->seed, "Seed of the envs and the learner");
   cmd->add_option("--hp", o->hp, "Hyperparameter override name=value (repeatable)");
