@@ -1,5 +1,6 @@
-// `cradle bench --config FILE [--steps N] [--seed S] [--json]`: env steps/s with a random policy,
-// per-module time per step, and bare mj_step on the same compiled model, measured in one run.
+// `cradle bench --config FILE | --env NAME [--steps N] [--seed S] [--json]`: env steps/s with a
+// random policy, per-module time per step, and bare mj_step on the same compiled model, measured
+// in one run. --env takes a MIMo sample env (MIMoReach-v0, ...; "all" runs every one).
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "envs/babybench.h"
+#include "envs/mimo/sample_env.h"
 
 namespace cradle::apps {
 namespace {
@@ -21,10 +23,12 @@ struct BenchResult {
   int steps = 0, frame_skip = 1;
 };
 
-BenchResult run_bench(const Config& config, int steps, std::uint64_t seed) {
+// Times `steps` env steps with random actions, then frame_skip x steps bare mj_steps from
+// `start` on the same model.
+template <typename EnvT>
+BenchResult time_env(EnvT& env, const mjModel* m, ActuationModel actuation, int frame_skip,
+                     const sim::State& start, int steps, std::uint64_t seed) {
   using Clock = std::chrono::steady_clock;
-  const auto assets = envs::make_assets(config);
-  envs::BabyBenchEnv env(assets, seed);
   env.reset(seed);
   env.clear_profile();
 
@@ -42,14 +46,13 @@ BenchResult run_bench(const Config& config, int steps, std::uint64_t seed) {
   }
 
   // Bare physics: the same model and start state, random controls, frame_skip steps per action.
-  const mjModel* m = assets->model.get();
-  sim::Sim bare(m, config.actuation_model, 1);
-  bare.restore(assets->settled);
+  sim::Sim bare(m, actuation, 1);
+  bare.restore(start);
   mjData* d = bare.data();
-  const int substeps = steps * config.frame_skip;
+  const int substeps = steps * frame_skip;
   const Clock::time_point t = Clock::now();
   for (int i = 0; i < substeps; ++i) {
-    if (i % config.frame_skip == 0) {
+    if (i % frame_skip == 0) {
       for (int u = 0; u < m->nu; ++u) {
         const bool limited = m->actuator_ctrllimited[u];
         d->ctrl[u] =
@@ -63,11 +66,11 @@ BenchResult run_bench(const Config& config, int steps, std::uint64_t seed) {
 
   BenchResult r;
   r.steps = steps;
-  r.frame_skip = config.frame_skip;
+  r.frame_skip = frame_skip;
   r.env_steps_per_s = steps / env_seconds;
   r.bare_steps_per_s = substeps / bare_seconds;
-  r.ratio = (env_seconds / steps) / (config.frame_skip * bare_seconds / substeps);
-  r.realtime_factor = r.env_steps_per_s * config.frame_skip * m->opt.timestep;
+  r.ratio = (env_seconds / steps) / (frame_skip * bare_seconds / substeps);
+  r.realtime_factor = r.env_steps_per_s * frame_skip * m->opt.timestep;
   const envs::Profile& p = env.profile();
   const double n = static_cast<double>(p.steps);
   r.per_step = {.physics = p.physics / n,
@@ -84,32 +87,29 @@ BenchResult run_bench(const Config& config, int steps, std::uint64_t seed) {
   return r;
 }
 
-}  // namespace
+BenchResult run_bench(const Config& config, int steps, std::uint64_t seed) {
+  const auto assets = envs::make_assets(config);
+  envs::BabyBenchEnv env(assets, seed);
+  return time_env(env, assets->model.get(), config.actuation_model, config.frame_skip,
+                  assets->settled, steps, seed);
+}
 
-void register_bench(CLI::App& app) {
-  struct Options {
-    std::string config;
-    int steps = 2000;
-    std::uint64_t seed = 0;
-    bool json = false;
-  };
-  auto opts = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "bench", "Measure env steps/s with a random policy against bare mj_step on the same model");
-  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
-  cmd->add_option("--steps", opts->steps, "Env steps to time")->check(CLI::Range(1, 100000000));
-  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy");
-  cmd->add_flag("--json", opts->json, "Print one JSON object");
-  cmd->callback([opts] {
-    const Config config = load_config(opts->config);
-    const BenchResult r = run_bench(config, opts->steps, opts->seed);
+BenchResult run_sample_bench(const std::string& name, int steps, std::uint64_t seed) {
+  const auto assets = envs::make_sample_assets(name);
+  auto env = envs::make_sample_env(assets, seed);
+  return time_env(*env, env->model(), assets->actuation, assets->definition.frame_skip,
+                  assets->init, steps, seed);
+}
+
+void print_bench(const std::string& label, const BenchResult& r, bool json) {
+  {
     const envs::Profile& p = r.per_step;
     const nlohmann::ordered_json modules = {
         {"physics", p.physics * 1e6},       {"touch", p.touch * 1e6},
         {"vision", p.vision * 1e6},         {"proprioception", p.proprio * 1e6},
         {"vestibular", p.vestibular * 1e6}, {"other", p.other * 1e6}};
-    if (opts->json) {
-      const nlohmann::ordered_json out = {{"config", opts->config},
+    if (json) {
+      const nlohmann::ordered_json out = {{"config", label},
                                           {"steps", r.steps},
                                           {"frame_skip", r.frame_skip},
                                           {"env_steps_per_s", r.env_steps_per_s},
@@ -120,7 +120,7 @@ void register_bench(CLI::App& app) {
       std::printf("%s\n", out.dump(2).c_str());
       return;
     }
-    std::printf("%s: %d env steps (frame_skip %d)\n", opts->config.c_str(), r.steps, r.frame_skip);
+    std::printf("%s: %d env steps (frame_skip %d)\n", label.c_str(), r.steps, r.frame_skip);
     std::printf("  per env step (us):");
     for (const auto& [name, us] : modules.items()) {
       std::printf(" %s %.1f", name.c_str(), us.get<double>());
@@ -129,6 +129,40 @@ void register_bench(CLI::App& app) {
                 r.realtime_factor);
     std::printf("  bare  %10.0f mj_step/s on the same model\n", r.bare_steps_per_s);
     std::printf("  ratio %10.2f  (env step time / frame_skip bare steps)\n", r.ratio);
+  }
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+  struct Options {
+    std::string config;
+    std::string env;
+    int steps = 2000;
+    std::uint64_t seed = 0;
+    bool json = false;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Measure env steps/s with a random policy against bare mj_step on the same model");
+  cmd->add_option("--config", opts->config, "BabyBench YAML config");
+  cmd->add_option("--env", opts->env, "MIMo sample env (MIMoReach-v0, ...; all: every one)");
+  cmd->add_option("--steps", opts->steps, "Env steps to time")->check(CLI::Range(1, 100000000));
+  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy");
+  cmd->add_flag("--json", opts->json, "Print one JSON object");
+  cmd->callback([opts] {
+    if (opts->config.empty() == opts->env.empty()) {
+      throw UserError("bench: give either --config FILE or --env NAME");
+    }
+    std::vector<std::string> names = {opts->env};
+    if (opts->env == "all") names = envs::sample_env_names();
+    for (const std::string& name : names) {
+      const std::string label = opts->config.empty() ? name : opts->config;
+      const BenchResult r = opts->config.empty()
+                                ? run_sample_bench(name, opts->steps, opts->seed)
+                                : run_bench(load_config(opts->config), opts->steps, opts->seed);
+      print_bench(label, r, opts->json);
+    }
   });
 }
 

@@ -39,6 +39,8 @@ class ObservationBuffers {
 // Per-step information. Behaviours fill their own fields; `steps` is always set.
 struct Info {
   int steps = 0;  // env steps in this episode before this one (0 on the first step)
+  // MIMo sample envs: the task's success and failure flags of the last step.
+  bool is_success = false, is_failure = false;
   // Self-touch: MIMo geom ids touched by each hand since reset, in order of first contact.
   std::vector<int> right_hand_touches, left_hand_touches;
   // Hand regard: steps with each hand in the central field of view of each eye.

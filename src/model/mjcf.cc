@@ -135,6 +135,7 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
   sensor.leaf("accelerometer", {{"name", "vestibular_acc"}, {"site", "vestibular"}});
   sensor.leaf("gyro", {{"name", "vestibular_gyro"}, {"site", "vestibular"}});
   for (const TorqueSensor& t : infant.torque_sensors) {
+    if (options.torque_sensors && !options.torque_sensors->contains(t.name)) continue;
     sensor.leaf("torque", {{"name", kTorquePrefix + t.name}, {"site", t.site}});
   }
   out.sensor = sensor.str();
@@ -144,6 +145,7 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
   XmlWriter actuator;
   for (const Actuator& a : infant.actuators) {
     if (!options.act_groups[a.group]) continue;
+    if (options.actuators && !options.actuators->contains(a.name)) continue;
     const std::string name = kActuatorPrefix + a.name;
     const std::string joint = kJointPrefix + a.joint;
     if (options.actuation == ActuationModel::kPositional) {
@@ -178,10 +180,12 @@ InfantXml emit_infant(const Infant& infant, const EmitOptions& options) {
   for (const Body& b : infant.bodies) {
     const bool locked = options.lock_groups[body_group(b.name)];
     for (const Joint& j : b.joints) {
-      const bool active = locked && !options.scene_constrained_joints.contains(j.name);
+      const auto angle = options.lock_angles.find(j.name);
+      const bool pinned = angle != options.lock_angles.end();
+      const bool active = pinned || (locked && !options.scene_constrained_joints.contains(j.name));
       Attrs attrs{{"name", kJointPrefix + j.name},
                   {"joint1", kJointPrefix + j.name},
-                  {"polycoef", "0 1 0 0 0"},
+                  {"polycoef", pinned ? num(angle->second) + " 1 0 0 0" : "0 1 0 0 0"},
                   {"active", active ? "true" : "false"}};
       attrs.emplace_back("solimp", nums(kLockSolimp));
       attrs.emplace_back("solref", nums(kLockSolref));

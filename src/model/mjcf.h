@@ -2,6 +2,8 @@
 // (scene/compose.h) places the sections into one self-contained scene file.
 #pragma once
 
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -18,6 +20,12 @@ struct EmitOptions {
   // Joints the scene already pins with its own equality: their lock stays inactive, as in the
   // reference (which skips a lock when another active joint equality names the joint).
   std::set<std::string> scene_constrained_joints;
+  // Only these actuators and torque sensors (names without prefix) when set, e.g. a sample scene's
+  // right arm; the act_groups filter applies as well.
+  std::optional<std::set<std::string>> actuators;
+  std::optional<std::set<std::string>> torque_sensors;
+  // Joints whose lock starts active at the given angle (rad) instead of 0, whatever their group.
+  std::map<std::string, double> lock_angles;
 };
 
 // Proportional gain of positional actuators, per unit of actuator gear (N·m per rad per N·m):

@@ -14,6 +14,8 @@
 
 #include "core/config.h"
 #include "model/infant.h"
+#include "model/mjcf.h"
+#include "scene/world.h"
 
 namespace cradle::scene {
 
@@ -32,6 +34,22 @@ model::MimoVersion mimo_version_for(Behavior behavior);
 
 // The scene for a config; the config is embedded as a YAML comment at the top.
 SceneFiles compose_scene(const Config& config);
+
+// Everything a scene is made of: MIMo (version and emitter options) on his free joint at
+// `placement`, inside worlds whose fragments are placed in order.
+struct Composition {
+  std::string comment;  // XML comment at the top
+  model::MimoVersion version = model::MimoVersion::kV1;
+  model::EmitOptions emit;
+  std::vector<WorldFragments> worlds;
+  Placement placement;
+  std::string visual;   // children of <visual> besides <global>
+  int offscreen = 480;  // offscreen buffer edge (px)
+  std::array<double, 3> gravity{0, 0, -9.81};
+  double density = 0;  // of the medium (kg/m^3), e.g. 1.2 for air
+};
+// The scene text and texture files of a composition.
+SceneFiles compose(const Composition& composition);
 
 // Compiles from memory. Throws std::runtime_error with MuJoCo's message on failure.
 ModelPtr compile_scene(const SceneFiles& scene);

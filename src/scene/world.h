@@ -20,6 +20,7 @@ struct WorldFragments {
   std::string worldbody;  // lights, cameras, static and free bodies placed in <worldbody>
   std::string contact;    // <pair>/<exclude> elements
   std::string equality;   // <weld>/<joint> elements (may name MIMo bodies and robot: joints)
+  std::string tendon;     // <fixed>/<spatial> elements (may name robot: joints)
 };
 
 // Base room: floor planes, rug, skybox, five lights, cameras corner/top/side1/side2/closeup.

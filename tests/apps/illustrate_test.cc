@@ -1,0 +1,99 @@
+// `cradle illustrate` and `cradle bench --env` end to end: flag errors, saved models, progress,
+// videos, loading a saved model, and the sample env benchmark.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+// Runs cradle in `dir` (illustrate writes models/ under the working folder).
+CliResult cradle_in(const fs::path& dir, const std::string& args) {
+  const std::string cmd =
+      "cd '" + dir.string() + "' && " + std::string(CRADLE_BINARY) + " " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
+  r.status = WEXITSTATUS(pclose(pipe));
+  return r;
+}
+
+int lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST(Illustrate, BadFlagsAreOneLineErrors) {
+  const fs::path dir = fs::temp_directory_path();
+  for (const char* args :
+       {"--env reach --algorithm HER", "--env fly --algorithm PPO", "--env reach --algorithm XYZ",
+        "--env reach --algorithm PPO --load_model /no/such.ckpt",
+        "--env reach --algorithm PPO --save_every 0"}) {
+    const CliResult r = cradle_in(dir, std::string("illustrate ") + args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_EQ(lines(r.out), 1) << args << ": " << r.out;
+  }
+  EXPECT_NE(cradle_in(dir, "illustrate --env reach --algorithm HER").out.find("not supported"),
+            std::string::npos);
+}
+
+TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("cradle_illustrate_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  CliResult r = cradle_in(dir,
+                          "illustrate --env reach --algorithm PPO --train_for 64 --test_for 12 "
+                          "--save_every 32 --save_model tiny --hp n_steps=32 --hp batch_size=32 "
+                          "--render_video");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const fs::path models = dir / "models" / "reach" / "tiny";
+  EXPECT_TRUE(fs::exists(models / "model_1.ckpt"));
+  EXPECT_TRUE(fs::exists(models / "model_2.ckpt"));
+  EXPECT_FALSE(fs::exists(models / "model_3.ckpt"));
+  EXPECT_TRUE(fs::exists(models / "progress.csv"));
+  EXPECT_GT(fs::file_size(models / "episode_0.mp4"), 0u);
+  EXPECT_NE(r.out.find("success rate"), std::string::npos) << r.out;
+
+  r = cradle_in(dir,
+                "illustrate --env reach --algorithm PPO --test_for 5 --save_model tiny "
+                "--load_model " +
+                    (models / "model_2.ckpt").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("the trained policy"), std::string::npos) << r.out;
+  // Another algorithm's model is refused.
+  r = cradle_in(dir, "illustrate --env reach --algorithm A2C --test_for 5 --load_model " +
+                         (models / "model_2.ckpt").string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(Illustrate, BenchMeasuresASampleEnv) {
+  const CliResult r =
+      cradle_in(fs::temp_directory_path(), "bench --json --steps 50 --env MIMoReach-v0");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["config"], "MIMoReach-v0");
+  EXPECT_EQ(j["frame_skip"], 2);
+  EXPECT_GT(j["env_steps_per_s"].get<double>(), 0);
+  const CliResult bad = cradle_in(fs::temp_directory_path(), "bench --steps 5");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_EQ(lines(bad.out), 1) << bad.out;
+}
+
+}  // namespace
