@@ -58,8 +58,7 @@ scene::WorldFragments sample_floor() {
       "width=\"100\" height=\"100\"/>\n"
       "<texture name=\"texplane\" type=\"2d\" builtin=\"checker\" rgb1=\".2 .3 .4\" "
       "rgb2=\".1 .15 .2\" width=\"100\" height=\"100\"/>\n";
-  w.materials = {
-      {"matplane", "texplane", "texrepeat=\"1 1\" texuniform=\"true\""}};
+  w.materials = {{"matplane", "texplane", "texrepeat=\"1 1\" texuniform=\"true\""}};
   w.worldbody =
       "<light directional=\"false\" diffuse=\".4 .4 .4\" specular=\"0 0 0\" pos=\"0 0 10\" "
       "dir=\"0 0 -1\" castshadow=\"false\"/>\n"
