@@ -12,7 +12,6 @@
 #include <torch/torch.h>
 
 #include <chrono>
-#include <limits>
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
@@ -86,7 +85,7 @@ class A2c final : public Learner {
   void learn(long total_steps, const ProgressFn& on_progress) override {
     const Clock::time_point start = Clock::now();
     const long start_steps = steps_;
-    collector_.start(draw_seed());
+    collector_.start(draw_env_seed(generator_));
     // A2C's rollouts are short: report about every 2,048 steps per env, not every update.
     const long report_every = std::max<long>(1, 2048 / config_.n_steps);
     long iteration = 0;
@@ -173,12 +172,6 @@ class A2c final : public Learner {
             {"entropy", entropy.item<double>()},
             {"loss", total.item<double>()},
             {"std", torch::exp(policy_->log_std()).mean().item<double>()}};
-  }
-
-  // A seed for the envs, drawn from the learner's generator (restored by load).
-  std::uint64_t draw_seed() {
-    return static_cast<std::uint64_t>(
-        torch::randint(0, std::numeric_limits<int64_t>::max(), {1}, generator_).item<int64_t>());
   }
 
   const A2cSettings settings_;

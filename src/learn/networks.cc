@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/error.h"
@@ -31,6 +32,11 @@ void apply_torch_options(const LearnerOptions& options) {
           reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
     set_threads(options.torch_threads);
   }
+}
+
+std::uint64_t draw_env_seed(at::Generator& generator) {
+  return static_cast<std::uint64_t>(
+      torch::randint(0, std::numeric_limits<int64_t>::max(), {1}, generator).item<int64_t>());
 }
 
 // ---------------------------------------------------------------------------------------------

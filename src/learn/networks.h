@@ -14,6 +14,7 @@
 
 #include <torch/torch.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ struct PolicyConfig {
 
 // Applies LearnerOptions::device (only "cpu"; UserError otherwise) and torch_threads.
 void apply_torch_options(const LearnerOptions& options);
+
+// A seed for a learner's envs, drawn from its generator: the generator is saved in checkpoints,
+// so a resumed run resets its envs exactly as the saved one would have.
+std::uint64_t draw_env_seed(at::Generator& generator);
 
 // Fills a weight (2-D, or a conv kernel flattened to [out, rest]) with a random orthogonal
 // matrix times gain (Saxe et al. 2014; the sign-corrected QR of a Gaussian matrix).

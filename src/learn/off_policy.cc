@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <functional>
-#include <limits>
 #include <sstream>
 
 #include "core/error.h"
@@ -119,7 +118,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   const Clock::time_point start = Clock::now();
   const long start_steps = steps_;
   const int envs = env_.num_envs();
-  collector_.start(draw_seed());
+  collector_.start(draw_env_seed(generator_));
   torch::Tensor random = torch::zeros({envs, action_size()}, torch::kFloat32);
   records_.clear();
   while (steps_ < total_steps) {
@@ -172,11 +171,6 @@ void OffPolicyLearner::act(const envs::ObservationBuffers& observation, std::spa
   torch::NoGradGuard no_grad;
   pipeline_.process(observation, scratch_);
   unscale_actions(policy_action(scratch_, deterministic), env_.action_space(), action);
-}
-
-std::uint64_t OffPolicyLearner::draw_seed() {
-  return static_cast<std::uint64_t>(
-      torch::randint(0, std::numeric_limits<int64_t>::max(), {1}, generator_).item<int64_t>());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -159,8 +159,6 @@ class OffPolicyLearner : public Learner {
   at::Generator& generator() { return generator_; }
 
  private:
-  std::uint64_t draw_seed();
-
   const std::string algorithm_;
   VecEnv& env_;
   const OffPolicyConfig config_;

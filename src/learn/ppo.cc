@@ -100,7 +100,7 @@ class Ppo final : public Learner {
   void learn(long total_steps, const ProgressFn& on_progress) override {
     const Clock::time_point start = Clock::now();
     const long start_steps = steps_;
-    collector_.start(draw_seed());
+    collector_.start(draw_env_seed(generator_));
     while (steps_ < total_steps) {
       // Learning rate for this iteration: constant, or annealed linearly to 0.
       double learning_rate = config_.learning_rate;
@@ -234,13 +234,6 @@ class Ppo final : public Learner {
     const double var = returns.var(/*unbiased=*/false).item<double>();
     if (var == 0) return std::numeric_limits<double>::quiet_NaN();
     return 1.0 - (returns - values).var(/*unbiased=*/false).item<double>() / var;
-  }
-
-  // A seed for the envs, drawn from the learner's generator (restored by load, so a resumed
-  // run resets its envs exactly as the saved one would have).
-  std::uint64_t draw_seed() {
-    return static_cast<std::uint64_t>(
-        torch::randint(0, std::numeric_limits<int64_t>::max(), {1}, generator_).item<int64_t>());
   }
 
   const PpoSettings settings_;
