@@ -133,21 +133,16 @@ void check_bounded_actions(std::string_view algorithm, const Box& bounds) {
 
 TransitionCollector::TransitionCollector(VecEnv& env, ObservationPipeline& pipeline,
                                          RewardHook reward_hook)
-    : env_(env), pipeline_(pipeline), reward_hook_(std::move(reward_hook)) {
+    : env_(env), pipeline_(pipeline), stepper_(env, std::move(reward_hook)) {
   const int envs = env.num_envs();
   raw_ = ObsBatch::zeros(pipeline.shape(), envs);
   next_raw_ = ObsBatch::zeros(pipeline.shape(), envs);
   normalized_ = ObsBatch::zeros(pipeline.shape(), envs);
-  pending_.assign(envs, 0);
-  keep_.assign(envs, 0);
   actions_.resize(static_cast<size_t>(envs) * env.action_space().size());
-  rewards_.resize(envs);
 }
 
 void TransitionCollector::start(std::uint64_t seed) {
-  env_.reset(seed);
-  pending_.assign(env_.num_envs(), 0);
-  episodes_.reset(env_.num_envs());
+  stepper_.start(seed);
   pipeline_.process_raw(env_, /*update_stats=*/true, raw_);
   normalize_current();
 }
@@ -159,29 +154,11 @@ void TransitionCollector::normalize_current() {
 
 void TransitionCollector::step(const torch::Tensor& actions, ReplayBuffer& buffer) {
   unscale_actions(actions, env_.action_space(), actions_);
-  env_.step(actions_);
-  const std::span<const double> env_rewards = env_.rewards();
-  std::copy(env_rewards.begin(), env_rewards.end(), rewards_.begin());
-  if (reward_hook_) reward_hook_(env_, actions_, rewards_);
-
-  // Real transitions only: an env autoreset by this step has no (s, a, r, s') to store.
-  const std::span<const std::uint8_t> terminated = env_.terminated();
-  const std::span<const std::uint8_t> truncated = env_.truncated();
-  for (int e = 0; e < env_.num_envs(); ++e) {
-    keep_[e] = !pending_[e];
-    if (pending_[e]) {
-      pending_[e] = 0;
-      continue;
-    }
-    episodes_.add(e, rewards_[e]);
-    if (terminated[e] || truncated[e]) {
-      episodes_.end(e);
-      pending_[e] = 1;
-    }
-  }
+  stepper_.step(actions_);
   // The next observations: on a done step the final one, which truncation bootstraps from.
   pipeline_.process_raw(env_, /*update_stats=*/true, next_raw_);
-  buffer.add(raw_, actions, rewards_, next_raw_, terminated, keep_);
+  // Real transitions only: an env autoreset by this step has no (s, a, r, s') to store.
+  buffer.add(raw_, actions, stepper_.rewards(), next_raw_, env_.terminated(), stepper_.real());
   std::swap(raw_, next_raw_);
   normalize_current();
 }

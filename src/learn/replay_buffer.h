@@ -85,19 +85,16 @@ class TransitionCollector {
   // reward hook, stores every real transition (not autoreset steps) and reads the next
   // observations (updating the normaliser's statistics).
   void step(const torch::Tensor& actions, ReplayBuffer& buffer);
-  EpisodeStats& episodes() { return episodes_; }
+  EpisodeStats& episodes() { return stepper_.episodes(); }
 
  private:
   void normalize_current();
 
   VecEnv& env_;
   ObservationPipeline& pipeline_;
-  RewardHook reward_hook_;
+  EnvStepper stepper_;
   ObsBatch raw_, next_raw_, normalized_;
-  std::vector<std::uint8_t> pending_;  // env ended its episode; the next step autoresets it
-  std::vector<std::uint8_t> keep_;
-  std::vector<double> actions_, rewards_;
-  EpisodeStats episodes_;
+  std::vector<double> actions_;
 };
 
 // Rescales actions in [-1, 1] to the bounds: low + (a + 1) (high - low) / 2, clipped to them.

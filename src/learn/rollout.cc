@@ -109,21 +109,54 @@ void clip_actions(const torch::Tensor& samples, const Box& bounds, std::span<dou
   }
 }
 
+EnvStepper::EnvStepper(VecEnv& env, RewardHook reward_hook)
+    : env_(env), reward_hook_(std::move(reward_hook)) {
+  rewards_.resize(env.num_envs());
+  pending_.assign(env.num_envs(), 0);
+  real_.assign(env.num_envs(), 0);
+}
+
+void EnvStepper::start(std::uint64_t seed) {
+  env_.reset(seed);
+  pending_.assign(env_.num_envs(), 0);
+  episodes_.reset(env_.num_envs());
+}
+
+void EnvStepper::step(std::span<const double> actions) {
+  env_.step(actions);
+  const std::span<const double> env_rewards = env_.rewards();
+  std::copy(env_rewards.begin(), env_rewards.end(), rewards_.begin());
+  if (reward_hook_) reward_hook_(env_, actions, rewards_);
+
+  // An env that this step autoreset has no (s, a, r, s'); the others extend their episodes.
+  const std::span<const std::uint8_t> terminated = env_.terminated();
+  const std::span<const std::uint8_t> truncated = env_.truncated();
+  for (int e = 0; e < env_.num_envs(); ++e) {
+    real_[e] = !pending_[e];
+    if (pending_[e]) {
+      pending_[e] = 0;
+      continue;
+    }
+    episodes_.add(e, rewards_[e]);
+    if (terminated[e] || truncated[e]) {
+      episodes_.end(e);
+      pending_[e] = 1;
+    }
+  }
+}
+
 RolloutCollector::RolloutCollector(VecEnv& env, ObservationPipeline& pipeline,
                                    RewardHook reward_hook)
-    : env_(env), pipeline_(pipeline), reward_hook_(std::move(reward_hook)) {
+    : env_(env), pipeline_(pipeline), stepper_(env, std::move(reward_hook)) {
   const int envs = env.num_envs();
   const int action_size = env.action_space().size();
   observation_ = ObsBatch::zeros(pipeline.shape(), envs);
   noise_ = torch::zeros({envs, action_size}, torch::kFloat32);
   actions_.resize(static_cast<size_t>(envs) * action_size);
-  rewards_.resize(envs);
 }
 
 void RolloutCollector::start(std::uint64_t seed) {
-  env_.reset(seed);
-  pending_.assign(env_.num_envs(), 0);
-  episodes_.reset(env_.num_envs());
+  stepper_.start(seed);
   pipeline_.process(env_, /*update_stats=*/true, observation_);
 }
 
@@ -151,33 +184,20 @@ void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& gener
                 sizeof(float) * envs);
 
     clip_actions(actions, env_.action_space(), actions_);
-    env_.step(actions_);
-    const std::span<const double> env_rewards = env_.rewards();
-    std::copy(env_rewards.begin(), env_rewards.end(), rewards_.begin());
-    if (reward_hook_) reward_hook_(env_, actions_, rewards_);
+    stepper_.step(actions_);
 
     const std::span<const std::uint8_t> terminated = env_.terminated();
     const std::span<const std::uint8_t> truncated = env_.truncated();
+    const std::span<const std::uint8_t> real = stepper_.real();
     float* rewards = buffer.rewards.data_ptr<float>() + row;
     std::uint8_t* terminal = buffer.terminated.data_ptr<std::uint8_t>() + row;
     std::uint8_t* done = buffer.dones.data_ptr<std::uint8_t>() + row;
     std::uint8_t* valid = buffer.valid.data_ptr<std::uint8_t>() + row;
     for (int e = 0; e < envs; ++e) {
-      if (pending_[e]) {  // this step reset env e: no transition
-        rewards[e] = 0;
-        terminal[e] = done[e] = valid[e] = 0;
-        pending_[e] = 0;
-        continue;
-      }
-      rewards[e] = static_cast<float>(rewards_[e]);
-      terminal[e] = terminated[e];
-      done[e] = terminated[e] || truncated[e];
-      valid[e] = 1;
-      episodes_.add(e, rewards_[e]);
-      if (done[e]) {
-        episodes_.end(e);
-        pending_[e] = 1;
-      }
+      valid[e] = real[e];
+      rewards[e] = real[e] ? static_cast<float>(stepper_.rewards()[e]) : 0.0f;
+      terminal[e] = real[e] && terminated[e];
+      done[e] = real[e] && (terminated[e] || truncated[e]);
     }
     pipeline_.process(env_, /*update_stats=*/true, observation_);
   }

@@ -75,6 +75,31 @@ class EpisodeStats {
   int ended_ = 0;
 };
 
+// Steps a VecEnv for a learner: applies the reward hook and follows next-step autoreset, telling
+// which entries of a step are real transitions (an env reset by the step has none) and tallying
+// the episodes they complete. Shared by the on-policy and off-policy collectors.
+class EnvStepper {
+ public:
+  EnvStepper(VecEnv& env, RewardHook reward_hook);
+  // Starts fresh episodes: resets every env with `seed`.
+  void start(std::uint64_t seed);
+  // Sends actions (num_envs x action dim, within the bounds) and applies the reward hook.
+  void step(std::span<const double> actions);
+  // Of the last step: the rewards to train on (env reward plus the hook's), and per env 1 for a
+  // real transition, 0 for an autoreset.
+  std::span<const double> rewards() const { return rewards_; }
+  std::span<const std::uint8_t> real() const { return real_; }
+  EpisodeStats& episodes() { return episodes_; }
+
+ private:
+  VecEnv& env_;
+  RewardHook reward_hook_;
+  std::vector<double> rewards_;
+  std::vector<std::uint8_t> pending_;  // env ended its episode; the next step autoresets it
+  std::vector<std::uint8_t> real_;
+  EpisodeStats episodes_;
+};
+
 // Runs a GaussianActorCritic in a VecEnv and fills rollout buffers.
 class RolloutCollector {
  public:
@@ -85,17 +110,15 @@ class RolloutCollector {
   // bounds for the env), step, apply the reward hook, record flags, normalise the next
   // observations (updating the statistics); then the values of the last observations.
   void collect(GaussianActorCritic& policy, at::Generator& generator, RolloutBuffer& buffer);
-  EpisodeStats& episodes() { return episodes_; }
+  EpisodeStats& episodes() { return stepper_.episodes(); }
 
  private:
   VecEnv& env_;
   ObservationPipeline& pipeline_;
-  RewardHook reward_hook_;
-  ObsBatch observation_;               // current normalised observations, one row per env
-  std::vector<std::uint8_t> pending_;  // env ended its episode; the next step autoresets it
-  torch::Tensor noise_;                // [envs, action_size]
-  std::vector<double> actions_, rewards_;
-  EpisodeStats episodes_;
+  EnvStepper stepper_;
+  ObsBatch observation_;  // current normalised observations, one row per env
+  torch::Tensor noise_;   // [envs, action_size]
+  std::vector<double> actions_;
 };
 
 // Writes actions[i] = clamp(samples[i], low[i], high[i]) (doubles, row-major).
