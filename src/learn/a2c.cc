@@ -12,6 +12,7 @@
 #include <torch/torch.h>
 
 #include <chrono>
+#include <utility>
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
@@ -90,6 +91,7 @@ class A2c final : public Learner {
     const long report_every = std::max<long>(1, 2048 / config_.n_steps);
     long iteration = 0;
     std::map<std::string, double> sums;
+    double collect_seconds = 0, update_seconds = 0;  // since the last report
     while (steps_ < total_steps) {
       // Learning rate for this iteration: constant, or annealed linearly to 0.
       double learning_rate = config_.learning_rate;
@@ -99,12 +101,16 @@ class A2c final : public Learner {
       for (auto& group : optimizer_.param_groups()) group.options().set_lr(learning_rate);
 
       // Collect a rollout with the current policy, then n-step advantages and value targets.
+      const Clock::time_point collect_start = Clock::now();
       collector_.collect(policy_, generator_, buffer_);
       steps_ += buffer_.rows();
       buffer_.compute_returns_and_advantages(config_.gamma, config_.gae_lambda);
 
       // One gradient step on the whole rollout.
+      const Clock::time_point update_start = Clock::now();
       for (const auto& [name, value] : update()) sums[name] += value;
+      collect_seconds += std::chrono::duration<double>(update_start - collect_start).count();
+      update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();
       ++iteration;
 
       if (iteration % report_every != 0 && steps_ < total_steps) continue;
@@ -113,6 +119,8 @@ class A2c final : public Learner {
       for (const auto& [name, value] : sums) stats.losses[name] = value / updates;
       sums.clear();
       stats.losses["learning_rate"] = learning_rate;
+      stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
+      stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
       const EpisodeStats::Summary episodes = collector_.episodes().take();
       stats.episodes = episodes.episodes;
       stats.episodic_return = episodes.mean_return;

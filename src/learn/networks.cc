@@ -2,9 +2,11 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <thread>
 
 #include "core/error.h"
 
@@ -19,19 +21,44 @@ void PolicyConfig::bind(Hyperparameters& table) {
   table.add("log_std_init", &log_std_init, "initial log std of the Gaussian (SB3 log_std_init)");
 }
 
-void apply_torch_options(const LearnerOptions& options) {
-  if (options.device != "cpu") {
-    throw UserError("device '" + options.device + "': this build trains on the cpu only");
-  }
-  if (options.torch_threads <= 0) return;
-  torch::set_num_threads(options.torch_threads);
+namespace {
+void set_torch_threads(int threads) {
+  torch::set_num_threads(threads);
   // Debian's LibTorch does its matrix products in OpenBLAS, whose own thread pool LibTorch's
   // setting does not reach: its workers would spin on the cores the envs step on.
   using SetThreads = void (*)(int);
   if (auto* set_threads =
           reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
-    set_threads(options.torch_threads);
+    set_threads(threads);
   }
+}
+}  // namespace
+
+void apply_torch_options(const LearnerOptions& options) {
+  if (options.device != "cpu") {
+    throw UserError("device '" + options.device + "': this build trains on the cpu only");
+  }
+  if (options.update_threads < 0) {
+    throw UserError("update_threads " + std::to_string(options.update_threads) +
+                    ": expected 0 (every core) or more");
+  }
+  if (options.torch_threads > 0) set_torch_threads(options.torch_threads);
+}
+
+ScopedTorchThreads::ScopedTorchThreads(int threads) {
+  if (threads <= 0 || threads == torch::get_num_threads()) return;
+  previous_ = torch::get_num_threads();
+  torch::set_num_threads(threads);
+}
+
+ScopedTorchThreads::~ScopedTorchThreads() {
+  if (previous_ > 0) torch::set_num_threads(previous_);
+}
+
+int update_threads(const LearnerOptions& options, const ObsShape& shape) {
+  if (shape.images.empty()) return 0;
+  if (options.update_threads > 0) return options.update_threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
 std::uint64_t draw_env_seed(at::Generator& generator) {

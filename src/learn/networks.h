@@ -37,6 +37,23 @@ struct PolicyConfig {
 // Applies LearnerOptions::device (only "cpu"; UserError otherwise) and torch_threads.
 void apply_torch_options(const LearnerOptions& options);
 
+// LibTorch's and OpenBLAS's thread counts set to `threads` for a scope (a gradient update of an
+// image policy), then set back; 0 or less changes nothing.
+class ScopedTorchThreads {
+ public:
+  explicit ScopedTorchThreads(int threads);
+  ~ScopedTorchThreads();
+  ScopedTorchThreads(const ScopedTorchThreads&) = delete;
+  ScopedTorchThreads& operator=(const ScopedTorchThreads&) = delete;
+
+ private:
+  int previous_ = 0;  // 0: nothing to restore
+};
+
+// Threads for the gradient updates of a policy: LearnerOptions::update_threads (0: every core)
+// when the observation has images, whose convolutions scale; 0 (unchanged) for vector policies.
+int update_threads(const LearnerOptions& options, const ObsShape& shape);
+
 // A seed for a learner's envs, drawn from its generator: the generator is saved in checkpoints,
 // so a resumed run resets its envs exactly as the saved one would have.
 std::uint64_t draw_env_seed(at::Generator& generator);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <functional>
 #include <sstream>
+#include <utility>
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
@@ -112,7 +113,8 @@ OffPolicyLearner::OffPolicyLearner(std::string algorithm, VecEnv& env,
       buffer_(checked_capacity(algorithm_, env, config_.buffer_size, pipeline_.shape()),
               pipeline_.shape(), env.action_space().size()),
       collector_(env, pipeline_, options.reward_hook),
-      scratch_(ObsBatch::zeros(pipeline_.shape(), 1)) {}
+      scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
+      update_threads_(update_threads(options, pipeline_.shape())) {}
 
 void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   const Clock::time_point start = Clock::now();
@@ -121,8 +123,10 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   collector_.start(draw_env_seed(generator_));
   torch::Tensor random = torch::zeros({envs, action_size()}, torch::kFloat32);
   records_.clear();
+  double collect_seconds = 0, update_seconds = 0;  // since the last report
   while (steps_ < total_steps) {
     // Act: uniformly at random until learning_starts, then the algorithm's exploration.
+    const Clock::time_point collect_start = Clock::now();
     torch::Tensor actions;
     if (steps_ < config_.learning_starts) {
       actions = random.uniform_(-1.0, 1.0, generator_);
@@ -133,9 +137,12 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     collector_.step(actions, buffer_);
     steps_ += envs;
     ++vector_steps_;
+    const Clock::time_point update_start = Clock::now();
+    collect_seconds += std::chrono::duration<double>(update_start - collect_start).count();
 
     // Train every train_freq vector steps once the buffer holds more than learning_starts.
     if (vector_steps_ % config_.train_freq == 0 && buffer_.size() > config_.learning_starts) {
+      const ScopedTorchThreads threads(update_threads_);
       for (int g = 0; g < config_.gradient_steps; ++g) {
         ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
         pipeline_.normalize(batch.observations.vector, batch.observations.vector);
@@ -143,6 +150,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
         train(batch, ++updates_);
       }
     }
+    update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();
 
     if (vector_steps_ % config_.report_every != 0 && steps_ < total_steps) continue;
     TrainStats stats{.steps = steps_};
@@ -150,6 +158,8 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     records_.clear();
     stats.losses["learning_rate"] = config_.learning_rate;
     stats.losses["buffer_transitions"] = static_cast<double>(buffer_.size());
+    stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
+    stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
     const EpisodeStats::Summary episodes = collector_.episodes().take();
     stats.episodes = episodes.episodes;
     stats.episodic_return = episodes.mean_return;

@@ -169,6 +169,7 @@ class OffPolicyLearner : public Learner {
   ReplayBuffer buffer_;
   TransitionCollector collector_;
   ObsBatch scratch_;  // one row, for act()
+  const int update_threads_;
   long steps_ = 0, vector_steps_ = 0, updates_ = 0;
   std::map<std::string, std::pair<double, long>> records_;  // sum and count since the report
   std::vector<std::pair<std::string, torch::nn::Module*>> modules_;

@@ -91,7 +91,8 @@ class Ppo final : public Learner {
                    torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_eps)),
         buffer_(config_.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
         collector_(env, pipeline_, options.reward_hook),
-        scratch_(ObsBatch::zeros(pipeline_.shape(), 1)) {}
+        scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
+        update_threads_(update_threads(options, pipeline_.shape())) {}
 
   std::string_view algorithm() const override { return "ppo"; }
   long steps() const override { return steps_; }
@@ -118,7 +119,10 @@ class Ppo final : public Learner {
       // Optimise the clipped surrogate on it.
       const Clock::time_point update_start = Clock::now();
       TrainStats stats{.steps = steps_};
-      stats.losses = update();
+      {
+        const ScopedTorchThreads threads(update_threads_);
+        stats.losses = update();
+      }
       stats.losses["learning_rate"] = learning_rate;
       stats.losses["collect_seconds"] = seconds_since(collect_start) - seconds_since(update_start);
       stats.losses["update_seconds"] = seconds_since(update_start);
@@ -247,6 +251,7 @@ class Ppo final : public Learner {
   RolloutBuffer buffer_;
   RolloutCollector collector_;
   ObsBatch scratch_;  // one row, for act()
+  const int update_threads_;
   long steps_ = 0;
 };
 

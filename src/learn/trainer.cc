@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <vector>
 
 #include "core/error.h"
@@ -39,7 +40,9 @@ const char* const kColumns[] = {"global_step",
                                 "losses/actor_loss",
                                 "losses/alpha",
                                 "losses/alpha_loss",
-                                "losses/qf1_values"};
+                                "losses/qf1_values",
+                                "perf/collect_seconds",
+                                "perf/update_seconds"};
 
 std::string cell(double v) {
   if (std::isnan(v)) return "";
@@ -126,6 +129,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   double score_sum = 0;
   int score_count = 0;
   LearnerOptions lo{.seed = options.seed, .hyperparameters = hyperparameters};
+  lo.update_threads = options.update_threads;
   lo.reward_hook = [&](const VecEnv& env, std::span<const double> actions,
                        std::span<double> rewards) {
     if (reward) reward->compute(env, actions, rewards);
@@ -154,15 +158,31 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (reward) reward->save(checkpoints);
   };
 
-  // progress.csv: appended on resume, new otherwise.
+  // progress.csv: appended on resume when its columns are this version's, new otherwise (an
+  // older file with other columns is kept beside it, renamed).
   const fs::path csv_file = dir / "logs" / "progress.csv";
-  const bool append = options.resume && fs::exists(csv_file);
+  std::string header;
+  for (size_t c = 0; c < std::size(kColumns); ++c)
+    header += (c ? "," : "") + std::string(kColumns[c]);
+  bool append = false;
+  if (options.resume && fs::exists(csv_file)) {
+    std::ifstream old(csv_file);
+    std::string first_line;
+    std::getline(old, first_line);
+    append = first_line == header;
+    if (!append) {
+      fs::path kept = dir / "logs" / "progress.before-resume.csv";
+      for (int k = 2; fs::exists(kept); ++k) {
+        kept = dir / "logs" / ("progress.before-resume-" + std::to_string(k) + ".csv");
+      }
+      fs::rename(csv_file, kept, ec);
+      if (ec) throw UserError("cannot rename '" + csv_file.string() + "': " + ec.message());
+      std::cerr << "progress.csv had other columns; kept as " << kept.string() << "\n";
+    }
+  }
   std::ofstream csv(csv_file, append ? std::ios::app : std::ios::trunc);
   if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
-  if (!append) {
-    for (size_t c = 0; c < std::size(kColumns); ++c) csv << (c ? "," : "") << kColumns[c];
-    csv << "\n";
-  }
+  if (!append) csv << header << "\n";
   std::vector<std::vector<double>> rows;
 
   const auto start = Clock::now();
@@ -194,7 +214,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                loss(s, "actor_loss"),
                                loss(s, "alpha"),
                                loss(s, "alpha_loss"),
-                               loss(s, "qf1_values")};
+                               loss(s, "qf1_values"),
+                               loss(s, "collect_seconds"),
+                               loss(s, "update_seconds")};
     for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
     csv << "\n";
     csv.flush();

@@ -192,3 +192,50 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
 }
 
 }  // namespace
+
+// Train, then resume to a larger budget: the run continues from the checkpoint's step count and
+// progress.csv keeps its rows; one written by an older version (other columns) is kept aside.
+TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
+  const fs::path dir = temp_dir("train");
+  std::ofstream(dir / "config.yml")
+      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+      << "\nvision_active: False\nmax_episode_steps: 100\n";
+  const std::string train = "train --config " + (dir / "config.yml").string() +
+                            " --envs 1 --hp n_steps=128 batch_size=64 n_epochs=1"
+                            " --eval-episodes 0 --checkpoint-every 128 --no-eval-video";
+  CliResult r = cradle(train + " --steps 256");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const fs::path csv = dir / "run" / "logs" / "progress.csv";
+  auto read_lines = [](const fs::path& file) {
+    std::ifstream in(file);
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line);
+    return rows;
+  };
+  std::vector<std::string> rows = read_lines(csv);
+  ASSERT_EQ(rows.size(), 3u);  // header, steps 128 and 256
+  EXPECT_TRUE(rows[0].find("perf/update_seconds") != std::string::npos) << rows[0];
+  EXPECT_EQ(rows[2].substr(0, 4), "256,");
+
+  // Same columns: appended.
+  r = cradle(train + " --steps 384 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  rows = read_lines(csv);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[3].substr(0, 4), "384,");
+
+  // Other columns: the old file is renamed, a new one started.
+  std::ofstream(csv) << "global_step,time\n128,1.0\n";
+  r = cradle(train + " --steps 512 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(read_lines(dir / "run" / "logs" / "progress.before-resume.csv").size(), 2u);
+  rows = read_lines(csv);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1].substr(0, 4), "512,");
+
+  // Resuming with nothing to resume from is a one-line error.
+  fs::remove_all(dir / "run" / "checkpoints");
+  r = cradle(train + " --steps 640 --resume");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+}

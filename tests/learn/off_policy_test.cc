@@ -212,7 +212,9 @@ std::vector<double> actions_of(Learner& learner, bool with_image, bool determini
 std::vector<double> train_losses(Learner& learner, long steps) {
   std::vector<double> losses;
   learner.learn(steps, [&](const TrainStats& stats) {
-    for (const auto& [name, value] : stats.losses) losses.push_back(value);
+    for (const auto& [name, value] : stats.losses) {
+      if (!name.ends_with("_seconds")) losses.push_back(value);  // timings vary
+    }
     return true;
   });
   return losses;
