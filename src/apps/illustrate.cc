@@ -43,6 +43,7 @@ struct IllustrateOptions {
   bool render_video = false;
   bool use_muscles = false;
   bool stochastic = false;
+  bool jitter = false, position_inaccurate = false, palm_up = false;  // catch only
   int envs = 1;
   std::uint64_t seed = 0;
   std::vector<std::string> hp;
@@ -110,6 +111,9 @@ void run(const IllustrateOptions& o) {
   // The reference passes the actuation model explicitly: muscles only with --use_muscles.
   envs::SampleOptions env_options;
   env_options.actuation = o.use_muscles ? ActuationModel::kMuscle : ActuationModel::kSpringDamper;
+  env_options.jitter = o.jitter;
+  env_options.position_inaccurate = o.position_inaccurate;
+  env_options.palm_up = o.palm_up;
   const auto assets = envs::make_sample_assets(id, env_options);
 
   // The learner trains on a vector of envs sharing the compiled scene.
@@ -280,6 +284,11 @@ void register_illustrate(CLI::App& app) {
                 "Muscle actuation instead of spring-damper motors");
   cmd->add_flag("--stochastic", o->stochastic,
                 "Test with sampled actions (SB3's predict default) instead of the policy's mean");
+  cmd->add_flag("--jitter", o->jitter, "Catch: random action gains, redrawn every 10-50 steps");
+  cmd->add_flag("--position_inaccurate", o->position_inaccurate,
+                "Catch: per-episode error of the head's aim at the ball");
+  cmd->add_flag("--palm_up", o->palm_up,
+                "Catch: wrist pinned palm-up as in MIMo's first catch scene");
   cmd->add_option("--envs", o->envs, "Parallel training envs (one thread each)");
   cmd->add_option("--seed", o->seed, "Seed of the envs and the learner");
   cmd->add_option("--hp", o->hp, "Hyperparameter override name=value (repeatable)");

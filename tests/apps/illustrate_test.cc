@@ -42,7 +42,8 @@ TEST(Illustrate, BadFlagsAreOneLineErrors) {
   for (const char* args :
        {"--env reach --algorithm HER", "--env fly --algorithm PPO", "--env reach --algorithm XYZ",
         "--env reach --algorithm PPO --load_model /no/such.ckpt",
-        "--env reach --algorithm PPO --save_every 0"}) {
+        "--env reach --algorithm PPO --save_every 0", "--env reach --algorithm PPO --palm_up",
+        "--env standup --algorithm PPO --jitter"}) {
     const CliResult r = cradle_in(dir, std::string("illustrate ") + args);
     EXPECT_EQ(r.status, 1) << args;
     EXPECT_EQ(lines(r.out), 1) << args << ": " << r.out;

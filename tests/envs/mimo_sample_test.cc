@@ -21,7 +21,8 @@ std::shared_ptr<const SampleAssets> assets(const std::string& name, SampleOption
   static std::map<std::string, std::shared_ptr<const SampleAssets>> cache;
   options.vision_resolution = 16;
   options.render_size = 64;
-  const std::string key = name + (options.actuation ? "/custom" : "");
+  const std::string key =
+      name + (options.actuation ? "/custom" : "") + (options.palm_up ? "/palm_up" : "");
   auto& slot = cache[key];
   if (!slot) slot = make_sample_assets(name, options);
   return slot;
@@ -319,6 +320,45 @@ TEST(MimoSample, CatchFailsWhenTheBallDrops) {
   EXPECT_TRUE(env->failure());
   EXPECT_TRUE(r.terminated);
   EXPECT_NEAR(r.reward, -100.0, 1e-9);
+}
+
+// The palm's normal is the hand's -y axis (the palm box is thin in y; fingers flex toward -y).
+double palm_normal_z(const MimoEnv& env) {
+  return -env.data()->xmat[9 * body_id(env.model(), "right_hand") + 7];
+}
+
+// The reference scene pins the arm but not the wrist: at rest the palm faces sideways (toward
+// the body's midline). palm_up pins the wrist rotation at MIMo's first scene's -1.4 rad, which
+// turns the palm up under the ball.
+TEST(MimoSample, CatchPalmFacesSidewaysUnlessPinnedUp) {
+  auto sideways = make_sample_env(assets("MIMoCatch-v0"), 1);
+  EXPECT_LT(std::abs(palm_normal_z(*sideways)), 0.3);
+  SampleOptions up;
+  up.palm_up = true;
+  auto upturned = make_sample_env(assets("MIMoCatch-v0", up), 1);
+  EXPECT_GT(palm_normal_z(*upturned), 0.95);
+  EXPECT_EQ(upturned->action_space().size(), sideways->action_space().size());
+  // The ball starts above the palm: within 3 cm of the hand in x and y.
+  const mjData* d = upturned->data();
+  const double* hand = d->xpos + 3 * body_id(upturned->model(), "right_hand");
+  const double* ball = d->xpos + 3 * body_id(upturned->model(), "target");
+  EXPECT_LT(std::hypot(ball[0] - hand[0], ball[1] - hand[1]), 0.03);
+  EXPECT_GT(ball[2] - hand[2], 0.15);
+}
+
+TEST(MimoSample, CatchOptionsOnOtherEnvsAreErrors) {
+  SampleOptions palm_up, jitter, no_penalty;
+  palm_up.palm_up = true;
+  jitter.jitter = true;
+  no_penalty.action_penalty = false;
+  for (const SampleOptions& options : {palm_up, jitter, no_penalty}) {
+    try {
+      make_sample_assets("MIMoReach-v0", options);
+      FAIL() << "no error for a catch option on reach";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find("MIMoCatch-v0 only"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(MimoSample, CatchBallSizeAndMassVaryPerEpisode) {

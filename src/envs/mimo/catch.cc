@@ -43,6 +43,10 @@ constexpr std::pair<const char*, double> kPinned[] = {
     {"right_th_distal", 0.3},
 };
 
+// palm_up: the wrist rotation's pin of MIMo's first catch scene (rad); it turns the palm up.
+constexpr const char* kWristRotation = "right_hand1";
+constexpr double kPalmUpAngle = -1.4;
+
 // Touch spacings (m) of the right arm.
 const std::map<std::string, double> kSkin = {
     {"right_upper_arm", 0.024},    {"right_lower_arm", 0.024}, {"right_hand", 0.007},
@@ -64,6 +68,7 @@ class CatchEnv final : public MimoEnv {
         ball_geom_(mj_name2id(model(), mjOBJ_GEOM, "target")),
         ball_qpos_(qpos_address(model(), "target_joint")),
         ball_dof_(model()->jnt_dofadr[mj_name2id(model(), mjOBJ_JOINT, "target_joint")]),
+        wrist_qpos_(qpos_address(model(), std::string("robot:") + kWristRotation)),
         zero_(action_space().size(), 0.0),
         gains_(action_space().size(), 1.0),
         jittered_(action_space().size()) {
@@ -84,6 +89,7 @@ class CatchEnv final : public MimoEnv {
       dd->qpos[ball_qpos_ + i] = kBallPos[i] + rng().uniform(-kBallJitter[i], kBallJitter[i]);
     }
     mju_zero(dd->qvel + ball_dof_, 6);
+    if (assets().options.palm_up) dd->qpos[wrist_qpos_] = kPalmUpAngle;
     radius_ = rng().uniform(kRadius[0], kRadius[1]);
     const double mass = rng().uniform(kMass[0], kMass[1]);
     m->geom_size[3 * ball_geom_] = radius_;
@@ -167,7 +173,7 @@ class CatchEnv final : public MimoEnv {
   void extra_observation(std::span<double> out) override { out[0] = radius_; }
 
   HeadTracking tracking_;
-  int hand_, ball_body_, ball_geom_, ball_qpos_, ball_dof_;
+  int hand_, ball_body_, ball_geom_, ball_qpos_, ball_dof_, wrist_qpos_;
   std::vector<char> sensing_;
   std::vector<double> zero_, gains_, jittered_;
   int gain_steps_ = 0;
@@ -191,7 +197,7 @@ SampleDefinition catch_definition() {
   def.camera_distance = 0.5;
   def.camera_azimuth = 120;
   def.camera_elevation = -30;
-  def.scene = [](const SampleOptions&) {
+  def.scene = [](const SampleOptions& options) {
     scene::Composition c;
     c.version = model::MimoVersion::kV2;
     c.worlds = {sample_floor()};
@@ -217,6 +223,7 @@ SampleDefinition catch_definition() {
     }
     c.emit.torque_sensors = sensors;
     for (const auto& [joint, angle] : kPinned) c.emit.lock_angles[joint] = angle;
+    if (options.palm_up) c.emit.lock_angles[kWristRotation] = kPalmUpAngle;
     scene::WorldFragments task;
     task.worldbody =
         "<body name=\"target\" pos=\"0.24 -0.04 0.8\">\n<joint name=\"target_joint\" "

@@ -107,6 +107,20 @@ std::shared_ptr<const SampleAssets> make_sample_assets(std::string_view name,
   if (options.vision_resolution < 1 || options.render_size < 1) {
     throw UserError("sample env: vision_resolution and render_size must be positive");
   }
+  // Catch's options on another env would silently do nothing.
+  if (it->name != "MIMoCatch-v0") {
+    const std::pair<bool, const char*> catch_only[] = {
+        {!options.action_penalty, "action_penalty"},
+        {options.jitter, "jitter"},
+        {options.position_inaccurate, "position_inaccurate"},
+        {options.palm_up, "palm_up"}};
+    for (const auto& [set, option] : catch_only) {
+      if (set) {
+        throw UserError("sample env option '" + std::string(option) + "' applies to " +
+                        "MIMoCatch-v0 only, not " + it->name);
+      }
+    }
+  }
   auto assets = std::make_shared<SampleAssets>();
   assets->definition = *it;
   assets->options = options;

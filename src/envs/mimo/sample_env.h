@@ -42,6 +42,11 @@ struct SampleOptions {
   bool action_penalty = true;        // -40 x muscle cost per step
   bool jitter = false;               // random per-dimension action gains, redrawn every 10-50 steps
   bool position_inaccurate = false;  // per-episode error of the head's aim at the ball
+  // The wrist's rotation pinned at -1.4 rad as in MIMo's first catch scene, so the ball falls on
+  // an open, upturned palm as the reference's documentation describes. The current reference
+  // scene leaves the wrist free: at rest the palm faces sideways and the ball lands on the edge
+  // of the hand unless the policy turns the palm up within the ~0.2 s fall.
+  bool palm_up = false;
 };
 
 // What a task's env is: its registration, scene, senses and defaults.
