@@ -54,3 +54,22 @@ def train_ppo(config, wrapper_class, reward_fn, train_for):
                           eval_episodes=0)
     print(f"trained {result['steps']} steps at {result['steps_per_second']:.0f} steps/s; "
           f"checkpoint {result['checkpoint']}; training score {result['training_score']}")
+
+
+def run_random_policy(description, default_config):
+    """The reference's random baselines: a random policy for --train_for steps in training mode
+    (save_dir gets scene.xml and logs/training.jsonl), then the training score."""
+    args = parse_args(description, default_config)
+    env = cradle.make_env(args.config, training=True)
+    env.reset()
+    env.reset()  # as the reference: two zero-step entries in the log
+    for _ in range(args.train_for):
+        action = env.action_space.sample()
+        obs, reward, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            env.reset()
+    env.close()
+    save_dir = cradle.config_dict(args.config)["save_dir"]
+    log = cradle.load_training_log(save_dir)
+    print(f"{len(log)} log entries; training score "
+          f"{cradle.training_score(log, env.behavior):.4f}")

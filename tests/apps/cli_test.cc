@@ -239,3 +239,23 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(lines(r.out), 1) << r.out;
 }
+
+// Off-policy resume: SAC continues from its checkpoint's step count (the replay buffer refills).
+TEST(Cli, SacResumesFromItsCheckpoint) {
+  const fs::path dir = temp_dir("train_sac");
+  std::ofstream(dir / "config.yml")
+      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+      << "\nvision_active: False\nmax_episode_steps: 100\n";
+  const std::string train = "train --algo sac --config " + (dir / "config.yml").string() +
+                            " --envs 1 --hp learning_starts=32 batch_size=16 report_every=64"
+                            " --eval-episodes 0 --checkpoint-every 64 --no-eval-video";
+  CliResult r = cradle(train + " --steps 128");
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = cradle(train + " --steps 192 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream csv(dir / "run" / "logs" / "progress.csv");
+  std::vector<std::string> steps;
+  for (std::string line; std::getline(csv, line);) steps.push_back(line.substr(0, line.find(',')));
+  const std::vector<std::string> expected = {"global_step", "64", "128", "192"};
+  EXPECT_EQ(steps, expected);
+}
