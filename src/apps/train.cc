@@ -42,8 +42,9 @@ void register_train(CLI::App& app) {
   cmd->add_option("--envs", opts->train.envs, "Parallel envs")->check(CLI::Range(1, 1024));
   cmd->add_option("--threads", opts->train.threads, "Worker threads (0: one per env, <= cores)")
       ->check(CLI::Range(0, 1024));
-  cmd->add_option("--update-threads", opts->train.update_threads,
-                  "LibTorch threads for gradient updates of image policies (0: every core)")
+  cmd->add_option(
+         "--update-threads", opts->train.update_threads,
+         "LibTorch threads for gradient updates (0: every core for image policies, 1 otherwise)")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--seed", opts->train.seed, "Seed of everything");
   cmd->add_flag("--resume", opts->train.resume, "Continue from <save_dir>/checkpoints/latest.ckpt");

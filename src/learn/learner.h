@@ -73,9 +73,8 @@ struct LearnerOptions {
   // LibTorch intra-op threads (a process-wide setting); 0 leaves it as it is. One thread is the
   // fastest for these small networks while the envs keep the other cores busy.
   int torch_threads = 1;
-  // LibTorch threads during the gradient updates of policies with image inputs, whose
-  // convolutions scale with cores while the envs wait; 0: every core. Vector-only policies
-  // update on torch_threads.
+  // LibTorch threads during gradient updates, while the envs wait. 0: every core for policies
+  // with image inputs, whose convolutions scale, and torch_threads for vector-only policies.
   int update_threads = 0;
 };
 

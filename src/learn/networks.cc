@@ -56,8 +56,8 @@ ScopedTorchThreads::~ScopedTorchThreads() {
 }
 
 int update_threads(const LearnerOptions& options, const ObsShape& shape) {
-  if (shape.images.empty()) return 0;
   if (options.update_threads > 0) return options.update_threads;
+  if (shape.images.empty()) return 0;
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 

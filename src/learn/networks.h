@@ -50,8 +50,9 @@ class ScopedTorchThreads {
   int previous_ = 0;  // 0: nothing to restore
 };
 
-// Threads for the gradient updates of a policy: LearnerOptions::update_threads (0: every core)
-// when the observation has images, whose convolutions scale; 0 (unchanged) for vector policies.
+// Threads for the gradient updates of a policy: LearnerOptions::update_threads when set; else
+// every core when the observation has images, whose convolutions scale, and 0 (unchanged: one
+// thread) for vector policies, whose small matrices gain nothing from a second thread.
 int update_threads(const LearnerOptions& options, const ObsShape& shape);
 
 // A seed for a learner's envs, drawn from its generator: the generator is saved in checkpoints,

@@ -24,8 +24,9 @@ struct TrainOptions {
   long steps = 100000;                          // env steps in total (counting a resumed run)
   int envs = 2;
   int threads = 0;  // 0: one per env, at most the cores
-  // LibTorch threads for the gradient updates of image policies (LearnerOptions).
-  int update_threads = 0;  // 0: every core
+  // LibTorch threads for gradient updates (LearnerOptions): 0: every core for image policies,
+  // one for vector policies.
+  int update_threads = 0;
   std::uint64_t seed = 0;
   bool resume = false;           // continue from <save_dir>/checkpoints/latest.ckpt
   bool randomize_start = false;  // random start postures within joint limits

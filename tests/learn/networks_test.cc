@@ -1,5 +1,5 @@
 // Torch thread settings of the learners: image policies update on every core, vector policies
-// leave the setting alone, and the scoped change is undone.
+// leave it alone unless the user sets update_threads, and the scoped change is undone.
 #include "learn/networks.h"
 
 #include <gtest/gtest.h>
@@ -19,7 +19,7 @@ TEST(UpdateThreads, ImagePoliciesUseEveryCoreVectorPoliciesNone) {
   EXPECT_EQ(update_threads({}, vector_only), 0);
   EXPECT_EQ(update_threads({}, with_images), cores);
   EXPECT_EQ(update_threads({.update_threads = 3}, with_images), 3);
-  EXPECT_EQ(update_threads({.update_threads = 3}, vector_only), 0);
+  EXPECT_EQ(update_threads({.update_threads = 3}, vector_only), 3);
 }
 
 TEST(UpdateThreads, ScopeSetsAndRestoresTorchThreads) {
