@@ -2,9 +2,9 @@
 // PPO|SAC|TD3|DDPG|A2C [--save_every K] [--save_model NAME] [--load_model PATH] [--use_muscles]
 // [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]`: the reference's
 // illustrations.py. Trains a policy on a MIMo sample env (checkpoints
-// models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv), then runs test_for
-// steps with it (or with random actions when there is no model), optionally filming each episode,
-// and prints the success rate and the mean return per episode.
+// models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv, learning-curve PNGs),
+// then runs test_for steps with it (or with random actions when there is no model), optionally
+// filming each episode, and prints the success rate and the mean return per episode.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -21,6 +21,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
+#include "eval/plot.h"
 #include "eval/video.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
@@ -73,6 +74,29 @@ std::string cell(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
+}
+
+// Learning curves of a training run, one point per update (NaN where no episode ended).
+struct Curves {
+  std::vector<double> steps, returns, success_rates;
+};
+
+// learning_curve_return.png and learning_curve_success.png in `dir`.
+void plot_curves(const Curves& c, const std::string& title, const fs::path& dir) {
+  auto series = [&](const std::vector<double>& y, const char* label, int color) {
+    return eval::Series{.label = label, .x = c.steps, .y = y, .color = eval::default_color(color)};
+  };
+  eval::write_png(eval::render_line_plot({.title = title + ": training return",
+                                          .x_label = "env steps",
+                                          .y_label = "return",
+                                          .series = {series(c.returns, "episodic return", 0)}}),
+                  dir / "learning_curve_return.png");
+  eval::write_png(eval::render_line_plot({.title = title + ": training success rate",
+                                          .x_label = "env steps",
+                                          .y_label = "success rate",
+                                          .series = {series(c.success_rates, "success rate", 1)},
+                                          .y_range = std::pair{0.0, 1.0}}),
+                  dir / "learning_curve_success.png");
 }
 
 void run(const IllustrateOptions& o) {
@@ -160,6 +184,7 @@ void run(const IllustrateOptions& o) {
                 o.train_for, o.envs, dir.c_str());
     // Success rate of the episodes that ended since the last update.
     long successes_seen = 0, ended_seen = 0;
+    Curves curves;
     learner->learn(total, [&](const learn::TrainStats& s) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = ended > ended_seen ? static_cast<double>(successes - successes_seen) /
@@ -170,6 +195,9 @@ void run(const IllustrateOptions& o) {
       csv << s.steps << "," << cell(elapsed) << "," << cell(s.sps) << "," << cell(s.episodic_return)
           << "," << cell(s.episodic_length) << "," << cell(rate) << "," << s.episodes << "\n";
       csv.flush();
+      curves.steps.push_back(static_cast<double>(s.steps));
+      curves.returns.push_back(s.episodic_return);
+      curves.success_rates.push_back(rate);
       if (s.steps >= next_save) {
         learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
         saved_at = s.steps;
@@ -190,6 +218,10 @@ void run(const IllustrateOptions& o) {
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
+    if (!curves.steps.empty()) {
+      plot_curves(curves, id + " " + o.algorithm, dir);
+      std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
+    }
   }
   // The vector stays alive: the learner keeps a reference to it.
 

@@ -67,6 +67,9 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   EXPECT_TRUE(fs::exists(models / "model_2.ckpt"));
   EXPECT_FALSE(fs::exists(models / "model_3.ckpt"));
   EXPECT_TRUE(fs::exists(models / "progress.csv"));
+  // Curves are drawn even when no training episode ended yet (reach lasts 1000 steps).
+  EXPECT_GT(fs::file_size(models / "learning_curve_return.png"), 0u);
+  EXPECT_GT(fs::file_size(models / "learning_curve_success.png"), 0u);
   EXPECT_GT(fs::file_size(models / "episode_0.mp4"), 0u);
   EXPECT_NE(r.out.find("success rate"), std::string::npos) << r.out;
 
