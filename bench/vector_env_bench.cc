@@ -4,8 +4,10 @@
 // other down.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -50,7 +52,10 @@ BENCHMARK(BM_VecEnvSelfTouch)
 // to back, 1 env on 1 thread, 2 envs on 2 threads (the vector), and 2 envs stepping freely on 2
 // threads with no synchronisation (the machine's ceiling: what two independent processes get).
 // Counters: vec_scaling = 2/2 over 1/1 steps/s; free_scaling = ceiling over 1/1;
-// vec_of_free = vec_scaling / free_scaling (what the vector's lock-step costs).
+// vec_of_free = vec_scaling / free_scaling (what the vector's lock-step costs);
+// lockstep_bound = the best lock-step scaling two perfect cores could give, from the vector's own
+// two envs stepped alternately on one thread: (sum of both step times) / (sum of the slower one's),
+// since each vector step waits for the slower env.
 void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
   using Clock = std::chrono::steady_clock;
   constexpr int kSteps = 100;  // vector steps per slice (about 40 ms)
@@ -60,10 +65,14 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
   const auto two = learn::make_babybench_vec_env(config, 2, 2, /*training=*/false, 0);
   const auto assets = envs::make_assets(config);
   envs::BabyBenchEnv free_a(assets, 1), free_b(assets, 2);
+  envs::BabyBenchEnv seq_a(assets, learn::ThreadedVecEnv::env_seed(0, 0));
+  envs::BabyBenchEnv seq_b(assets, learn::ThreadedVecEnv::env_seed(0, 1));
   one->reset(0);
   two->reset(0);
   free_a.reset();
   free_b.reset();
+  seq_a.reset();
+  seq_b.reset();
   const Box& space = one->action_space();
   const size_t dim = space.low.size();
   Rng rng(1);
@@ -84,7 +93,13 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
     }
     rate = kSteps / seconds(start);
   };
-  double one_time = 0, two_time = 0, free_rate = 0;
+  // One env step's duration.
+  const auto timed_step = [&](envs::BabyBenchEnv& env, std::span<const double> action) {
+    const Clock::time_point start = Clock::now();
+    if (env.step(action).truncated) env.reset();
+    return seconds(start);
+  };
+  double one_time = 0, two_time = 0, free_rate = 0, seq_sum = 0, seq_max = 0;
   long rounds = 0;
   for (auto _ : state) {
     Clock::time_point start = Clock::now();
@@ -98,6 +113,12 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
     run_free(free_a, rate_a);
     other.join();
     free_rate += rate_a + rate_b;
+    for (int t = 0; t < kSteps; ++t) {
+      const double a = timed_step(seq_a, std::span(actions[t]).first(dim));
+      const double b = timed_step(seq_b, std::span(actions[t]).last(dim));
+      seq_sum += a + b;
+      seq_max += std::max(a, b);
+    }
     ++rounds;
   }
   const double one_rate = rounds * kSteps / one_time;
@@ -106,6 +127,7 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
   state.counters["vec_scaling"] = two_rate / one_rate;
   state.counters["free_scaling"] = free_rate / rounds / one_rate;
   state.counters["vec_of_free"] = two_rate / (free_rate / rounds);
+  state.counters["lockstep_bound"] = seq_sum / seq_max;
 }
 BENCHMARK(BM_VecEnvScalingSelfTouch)->Unit(benchmark::kMillisecond)->UseRealTime();
 
