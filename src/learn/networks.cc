@@ -21,19 +21,6 @@ void PolicyConfig::bind(Hyperparameters& table) {
   table.add("log_std_init", &log_std_init, "initial log std of the Gaussian (SB3 log_std_init)");
 }
 
-namespace {
-void set_torch_threads(int threads) {
-  torch::set_num_threads(threads);
-  // Debian's LibTorch does its matrix products in OpenBLAS, whose own thread pool LibTorch's
-  // setting does not reach: its workers would spin on the cores the envs step on.
-  using SetThreads = void (*)(int);
-  if (auto* set_threads =
-          reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
-    set_threads(threads);
-  }
-}
-}  // namespace
-
 void apply_torch_options(const LearnerOptions& options) {
   if (options.device != "cpu") {
     throw UserError("device '" + options.device + "': this build trains on the cpu only");
@@ -42,7 +29,15 @@ void apply_torch_options(const LearnerOptions& options) {
     throw UserError("update_threads " + std::to_string(options.update_threads) +
                     ": expected 0 (every core) or more");
   }
-  if (options.torch_threads > 0) set_torch_threads(options.torch_threads);
+  if (options.torch_threads <= 0) return;
+  torch::set_num_threads(options.torch_threads);
+  // Debian's LibTorch does its matrix products in OpenBLAS, whose own thread pool LibTorch's
+  // setting does not reach: its workers would spin on the cores the envs step on.
+  using SetThreads = void (*)(int);
+  if (auto* set_threads =
+          reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
+    set_threads(options.torch_threads);
+  }
 }
 
 ScopedTorchThreads::ScopedTorchThreads(int threads) {

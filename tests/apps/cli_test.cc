@@ -45,6 +45,23 @@ int lines(const std::string& s) {
   return n;
 }
 
+// The lines of a text file.
+std::vector<std::string> read_lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(line);
+  return rows;
+}
+
+// A quick training config in dir/config.yml (self-touch, no vision, 100-step episodes) whose run
+// goes to dir/run; returns the config's path.
+std::string write_training_config(const fs::path& dir) {
+  const fs::path file = dir / "config.yml";
+  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+                      << "\nvision_active: False\nmax_episode_steps: 100\n";
+  return file.string();
+}
+
 TEST(Cli, BuildSceneWritesSceneAndTextures) {
   const fs::path dir = temp_dir("build");
   const CliResult r =
@@ -197,21 +214,12 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
 // progress.csv keeps its rows; one written by an older version (other columns) is kept aside.
 TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
   const fs::path dir = temp_dir("train");
-  std::ofstream(dir / "config.yml")
-      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-      << "\nvision_active: False\nmax_episode_steps: 100\n";
-  const std::string train = "train --config " + (dir / "config.yml").string() +
+  const std::string train = "train --config " + write_training_config(dir) +
                             " --envs 1 --hp n_steps=128 batch_size=64 n_epochs=1"
                             " --eval-episodes 0 --checkpoint-every 128 --no-eval-video";
   CliResult r = cradle(train + " --steps 256");
   ASSERT_EQ(r.status, 0) << r.out;
   const fs::path csv = dir / "run" / "logs" / "progress.csv";
-  auto read_lines = [](const fs::path& file) {
-    std::ifstream in(file);
-    std::vector<std::string> rows;
-    for (std::string line; std::getline(in, line);) rows.push_back(line);
-    return rows;
-  };
   std::vector<std::string> rows = read_lines(csv);
   ASSERT_EQ(rows.size(), 3u);  // header, steps 128 and 256
   EXPECT_TRUE(rows[0].find("perf/update_seconds") != std::string::npos) << rows[0];
@@ -243,19 +251,17 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
 // Off-policy resume: SAC continues from its checkpoint's step count (the replay buffer refills).
 TEST(Cli, SacResumesFromItsCheckpoint) {
   const fs::path dir = temp_dir("train_sac");
-  std::ofstream(dir / "config.yml")
-      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-      << "\nvision_active: False\nmax_episode_steps: 100\n";
-  const std::string train = "train --algo sac --config " + (dir / "config.yml").string() +
+  const std::string train = "train --algo sac --config " + write_training_config(dir) +
                             " --envs 1 --hp learning_starts=32 batch_size=16 report_every=64"
                             " --eval-episodes 0 --checkpoint-every 64 --no-eval-video";
   CliResult r = cradle(train + " --steps 128");
   ASSERT_EQ(r.status, 0) << r.out;
   r = cradle(train + " --steps 192 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  std::ifstream csv(dir / "run" / "logs" / "progress.csv");
   std::vector<std::string> steps;
-  for (std::string line; std::getline(csv, line);) steps.push_back(line.substr(0, line.find(',')));
+  for (const std::string& line : read_lines(dir / "run" / "logs" / "progress.csv")) {
+    steps.push_back(line.substr(0, line.find(',')));
+  }
   const std::vector<std::string> expected = {"global_step", "64", "128", "192"};
   EXPECT_EQ(steps, expected);
 }
