@@ -13,6 +13,8 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   python3 python3-numpy python3-dev pybind11-dev python3-pytest
   ccache
+  libbox2d-dev libcairo2-dev libzip-dev libeigen3-dev
+  python3-matplotlib python3-scipy python3-pandas
 )
 
 missing=()
