@@ -1,5 +1,6 @@
 #include "envs/training_log.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -24,11 +25,13 @@ double episode_score(Behavior behavior, const Info& info, int steps) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-TrainingLog::TrainingLog(std::filesystem::path file, Behavior behavior, int save_every, bool append)
+TrainingLog::TrainingLog(std::filesystem::path file, Behavior behavior, int save_every, bool append,
+                         long episodes)
     : file_(std::move(file)),
       behavior_(behavior),
       save_every_(save_every),
-      writer_(file_, append) {}
+      writer_(file_, append),
+      episodes_(append ? episodes : 0) {}
 
 TrainingLog::~TrainingLog() {
   try {
@@ -38,7 +41,7 @@ TrainingLog::~TrainingLog() {
   }
 }
 
-void TrainingLog::record(const Info& info, int steps) {
+void TrainingLog::record(const Info& info, int steps, int slot) {
   nlohmann::json entry = info.to_json(behavior_);
   entry["steps"] = steps;
   const double score = episode_score(behavior_, info, steps);
@@ -46,16 +49,39 @@ void TrainingLog::record(const Info& info, int steps) {
   std::lock_guard lock(mutex_);
   entry["wall_time"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // Ordered mode: wait for commit() (slot order); otherwise written now.
+  if (slot >= 0 && slot < static_cast<int>(pending_.size())) {
+    pending_[slot].push_back(std::move(entry));
+    return;
+  }
+  write_locked(entry);
+}
+
+void TrainingLog::write_locked(const nlohmann::json& entry) {
   writer_.write(entry);
   if (++episodes_ % save_every_ == 0) writer_.flush();
 }
 
+void TrainingLog::set_slots(int slots) {
+  std::lock_guard lock(mutex_);
+  pending_.resize(std::max(slots, 0));
+}
+
+void TrainingLog::commit() {
+  std::lock_guard lock(mutex_);
+  for (auto& entries : pending_) {
+    for (const nlohmann::json& entry : entries) write_locked(entry);
+    entries.clear();
+  }
+}
+
 void TrainingLog::flush() {
+  commit();
   std::lock_guard lock(mutex_);
   writer_.flush();
 }
 
-int TrainingLog::episodes() const {
+long TrainingLog::episodes() const {
   std::lock_guard lock(mutex_);
   return episodes_;
 }
