@@ -1,6 +1,6 @@
 // `cradle tma random|bench|info`: TeachMyAgent's environments from the command line.
 //   random --env stump-tracks|parkour --embodiment E [--task k=v ...] [--video out.mp4]
-//          [--steps N] [--seed S]: one random-policy episode (return, length, success);
+//          [--steps N] [--seed S] [--png F]: one random-policy episode (return, length, success);
 //   bench  --env ... --embodiment E|all [--steps N] [--json]: env steps/s and the ratio to the
 //          bare b2World::Step on the same world, measured in one run, plus the reset time;
 //   info   : observation / action sizes and masses of every embodiment in both envs (JSON).
@@ -14,7 +14,9 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "eval/plot.h"
 #include "eval/video.h"
+#include "model/textures.h"
 #include "tma/render.h"
 #include "tma/tma_env.h"
 
@@ -106,7 +108,8 @@ void register_tma(CLI::App& app) {
   tma_cmd->require_subcommand(1);
 
   struct RandomOptions {
-    std::string env = "stump-tracks", body = "old_classic_bipedal", video;
+    std::string env = "stump-tracks", body = "old_classic_bipedal", video, png;
+    int png_step = 60;
     std::vector<std::string> tasks;
     int steps = tma::kMaxEpisodeSteps;
     std::uint64_t seed = 0;
@@ -122,6 +125,9 @@ void register_tma(CLI::App& app) {
   random->add_option("--seed", ro->seed, "Seed of the env and the policy");
   random->add_flag("--movable-creepers", ro->movable_creepers, "Parkour: dynamic creepers");
   random->add_flag("--lidars", ro->lidars, "Draw the lidar rays in the video");
+  random->add_option("--png", ro->png, "Save the frame after --png-step steps as PNG");
+  random->add_option("--png-step", ro->png_step, "Step of the --png frame (or the last step)")
+      ->check(CLI::Range(0, 1000000));
   random->callback([ro] {
     tma::TmaEnv env(tma::TmaOptions{.env = tma::parse_env_id(ro->env),
                                     .body = ro->body,
@@ -142,9 +148,20 @@ void register_tma(CLI::App& app) {
     Rng rng(ro->seed + 1);
     std::vector<double> action(env.action_size());
     tma::TmaStep s;
+    auto snapshot = [&] {
+      model::Image image{.width = w, .height = h};
+      tma::render(env, w, h, ro->lidars, image.rgb);
+      eval::write_png(image, ro->png);
+    };
+    if (!ro->png.empty() && ro->png_step == 0) snapshot();
     do {
       for (double& a : action) a = rng.uniform(-1, 1);
       s = env.step(action);
+      const bool last = s.terminated || s.truncated;
+      if (!ro->png.empty() &&
+          (env.episode_steps() == ro->png_step || (last && env.episode_steps() < ro->png_step))) {
+        snapshot();
+      }
       if (video) {
         tma::render(env, w, h, ro->lidars, frame);
         video->write(frame);
