@@ -2,6 +2,7 @@
 
 #include <cairo.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -72,7 +73,6 @@ void render(const TmaEnv& env, int width, int height, bool draw_lidars,
   const double view_w = kViewportW / kScale;
   View v{.cr = cr, .sx = pos.x - view_w / 5, .sy = 0, .k = width / view_w, .h = double(height)};
   if (parkour) v.sy = pos.y - kViewportH / kScale / 5 - kTerrainHeight + 1 / kScale;
-  const double view_h = height / v.k;
   const Scene& scene = env.scene();
 
   // Sky and clouds (clouds scroll at half speed).
@@ -85,6 +85,20 @@ void render(const TmaEnv& env, int width, int height, bool draw_lidars,
     color(cr, cloud.color);
     cairo_fill(cr);
   }
+  // Ground (and ceiling) fills, only those in view; adjacent pieces share edges, so no
+  // antialiasing (it would leave seams).
+  auto fills = [&] {
+    cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
+    for (const Polygon& poly : scene.fills) {
+      if (poly.points[1].x < v.sx || poly.points[0].x > v.sx + view_w) continue;
+      path(v, poly.points.data(), static_cast<int>(poly.points.size()));
+      color(cr, poly.color);
+      cairo_fill(cr);
+    }
+    cairo_set_antialias(cr, CAIRO_ANTIALIAS_DEFAULT);
+  };
+  // Stump Tracks draws the ground behind everything; Parkour in front (it hides the water below).
+  if (!parkour) fills();
   // Water, stumps and creepers.
   for (const b2Body* body : scene.bodies) {
     const Tag* tag = tag_of(body);
@@ -110,14 +124,7 @@ void render(const TmaEnv& env, int width, int height, bool draw_lidars,
     const Rgb c = s.tag->has_joint ? Rgb{1, 1, 0} : s.tag->color1;
     draw_body(v, s.body, c, c);
   }
-  // Ground (and ceiling) fills in front, only those in view.
-  for (const Polygon& poly : scene.fills) {
-    if (poly.points[1].x < v.sx || poly.points[0].x > v.sx + view_w) continue;
-    path(v, poly.points.data(), static_cast<int>(poly.points.size()));
-    color(cr, poly.color);
-    cairo_fill(cr);
-  }
-  (void)view_h;
+  if (parkour) fills();
   // Lidar rays.
   if (draw_lidars) {
     cairo_set_source_rgb(cr, 1, 0, 0);
