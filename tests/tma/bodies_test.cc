@@ -76,6 +76,9 @@ TEST(TmaBodies, MassesMatchTheSpec) {
           0.19911, 0.035556, 0.0078540, 0.0078540},
          "climbing_profile_chimpanzee");
   expect(part_masses("fish"), {0.84480, 0.36960, 0.22880, 0.05280, 0.04400}, "fish");
+  // The amphibian: hull 1.25 and legs 0.25 times the water density.
+  expect(part_masses("amphibious_bipedal"),
+         {5.42222 / 4, 0.30222 / 4, 0.24178 / 4, 0.30222 / 4, 0.24178 / 4}, "amphibious_bipedal");
   // Inertia about the origin (used by the water push) and the hull's centre of mass.
   TmaEnv env = make(EnvId::kStumpTracks, "old_classic_bipedal");
   const b2Body* hull = env.agent().head;
@@ -124,6 +127,22 @@ TEST(TmaBodies, SameSeedAndTaskGiveIdenticalTrajectories) {
     ASSERT_EQ(runs[0].size(), runs[1].size());
     EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * sizeof(double)));
   }
+}
+
+// The episode cap truncates (not terminates); success is "return so far > 230".
+TEST(TmaBodies, EpisodeCapTruncates) {
+  TmaEnv env(TmaOptions{.env = EnvId::kParkour, .body = "fish", .max_episode_steps = 25});
+  env.set_environment({{"water_level", {1.0}}});
+  env.reset(0);
+  const std::vector<double> zero(4, 0.0);
+  TmaStep r;
+  for (int t = 0; t < 25; ++t) {
+    EXPECT_FALSE(r.truncated);
+    r = env.step(zero);
+  }
+  EXPECT_TRUE(r.truncated);
+  EXPECT_FALSE(r.terminated);
+  EXPECT_EQ(r.success, env.episode_return() > 230);
 }
 
 // Every wrong input is a UserError with a one-line message.
