@@ -472,7 +472,11 @@ std::string panda() {
   XmlWriter x;
   x.open("mujoco", {{"model", "panda_push"}});
   x.leaf("compiler", {{"angle", "radian"}, {"coordinate", "local"}, {"inertiafromgeom", "false"}});
-  x.leaf("option", {{"timestep", "0.002"}, {"gravity", "0 0 -9.81"}});
+  // Implicit in velocity: the stiff velocity servos below stay stable at 2 ms.
+  x.leaf("option", {{"timestep", "0.002"},
+                    {"gravity", "0 0 -9.81"},
+                    {"integrator", "implicit"},
+                    {"cone", "elliptic"}});
   x.open("default");
   // Arm links are visual only; the hand and the fingers (contype 2) touch the cube and table.
   // Stiff contacts (time constant 2 timesteps) so a resting cube sinks well under 1 mm.
@@ -481,20 +485,21 @@ std::string panda() {
                   {"condim", "3"},
                   {"solref", ".004 1"},
                   {"rgba", ".9 .9 .9 1"}});
-  // Joint damping (implicit in Euler) is the servos' derivative term: kd / kp = 10 ms.
-  x.leaf("joint", {{"limited", "true"}, {"armature", ".1"}, {"damping", "200"}});
+  x.leaf("joint", {{"limited", "true"}, {"armature", ".1"}, {"damping", "0"}});
   x.close();
   scenery(x);
   x.open("worldbody");
   light(x);
   x.leaf("camera",
          {{"name", "track"}, {"pos", "0.9 -0.9 0.7"}, {"xyaxes", ".707 .707 0 -.35 .35 .87"}});
+  // Contact bits: 1 table-cube, 2 fingers-table/cube, 4 ground-cube. The ground is a plane at its
+  // top face (z = -0.4); the hand never reaches the table or the cube and collides with nothing.
   x.leaf("geom", {{"name", "ground"},
-                  {"type", "box"},
-                  {"pos", "0 0 -.41"},
-                  {"size", "3 3 .01"},
-                  {"contype", "1"},
-                  {"conaffinity", "1"},
+                  {"type", "plane"},
+                  {"pos", "0 0 -.4"},
+                  {"size", "3 3 .1"},
+                  {"contype", "4"},
+                  {"conaffinity", "4"},
                   {"friction", ".25 0 0"},
                   {"material", "grid"}});
   x.leaf("geom", {{"name", "table"},
@@ -502,7 +507,7 @@ std::string panda() {
                   {"pos", "-.3 0 -.2"},
                   {"size", ".55 .35 .2"},
                   {"contype", "1"},
-                  {"conaffinity", "1"},
+                  {"conaffinity", "3"},
                   {"friction", "1 0 0"},
                   {"rgba", ".55 .45 .35 1"}});
   x.open("body", {{"name", "object"}, {"pos", "0 0 .02"}});
@@ -512,8 +517,8 @@ std::string panda() {
   x.leaf("geom", {{"name", "object"},
                   {"type", "box"},
                   {"size", ".02 .02 .02"},
-                  {"contype", "1"},
-                  {"conaffinity", "1"},
+                  {"contype", "5"},
+                  {"conaffinity", "5"},
                   {"friction", "1e-5 0 0"},
                   {"rgba", ".1 .8 .1 1"}});
   x.close();
@@ -566,13 +571,7 @@ std::string panda() {
                   {"pos", "0 0 .107"},
                   {"quat", nums({std::cos(-M_PI / 8), 0, 0, std::sin(-M_PI / 8)})}});
   inertia(0.81, {0, 0, 0.04});
-  x.leaf("geom", {{"name", "hand"},
-                  {"type", "box"},
-                  {"pos", "0 0 .03"},
-                  {"size", ".02 .09 .025"},
-                  {"contype", "2"},
-                  {"conaffinity", "1"},
-                  {"friction", ".5 0 0"}});
+  x.leaf("geom", {{"name", "hand"}, {"type", "box"}, {"pos", "0 0 .03"}, {"size", ".02 .09 .025"}});
   x.leaf("site",
          {{"name", "grasptarget"}, {"pos", "0 0 .105"}, {"size", ".005"}, {"rgba", "1 0 0 1"}});
   // Fingers: slides along the hand's +y (left) and -y (right); their inner faces are q apart from
@@ -587,8 +586,7 @@ std::string panda() {
                      {"type", "slide"},
                      {"axis", nums({0, s, 0})},
                      {"range", "0 .04"},
-                     {"armature", ".01"},
-                     {"damping", "20"}});
+                     {"armature", ".01"}});
     x.leaf("geom", {{"name", left ? "leftfinger" : "rightfinger"},
                     {"type", "box"},
                     {"pos", nums({0, 0.008 * s, 0.03})},
@@ -604,21 +602,17 @@ std::string panda() {
   x.close();  // link0
   x.close();  // worldbody
   x.open("actuator");
-  // Position servos (targets set by the env's IK each step) with the panda-gym motor forces.
-  const double forces[7] = {87, 87, 87, 87, 12, 120, 120};
-  for (int k = 0; k < 7; ++k) {
-    x.leaf("position", {{"name", "joint" + std::to_string(k + 1)},
-                        {"joint", "joint" + std::to_string(k + 1)},
-                        {"kp", "20000"},
+  // PyBullet's motors (§3.4) as velocity servos: the env sets ctrl = 50 (q* - q) every substep;
+  // a stiff kv makes the velocity follow it, limited by the panda-gym motor forces.
+  const double forces[9] = {87, 87, 87, 87, 12, 120, 120, 170, 170};
+  for (int k = 0; k < 9; ++k) {
+    const std::string joint =
+        k < 7 ? "joint" + std::to_string(k + 1) : (k == 7 ? "finger_joint1" : "finger_joint2");
+    x.leaf("velocity", {{"name", joint},
+                        {"joint", joint},
+                        {"kv", "80"},
                         {"forcelimited", "true"},
                         {"forcerange", nums({-forces[k], forces[k]})}});
-  }
-  for (const char* f : {"finger_joint1", "finger_joint2"}) {
-    x.leaf("position", {{"name", f},
-                        {"joint", f},
-                        {"kp", "2000"},
-                        {"forcelimited", "true"},
-                        {"forcerange", "-170 170"}});
   }
   x.close().close();
   return x.str();

@@ -13,9 +13,11 @@ constexpr double kHalfRange = 0.15;  // cube and goal x, y in [-0.15, 0.15]
 constexpr double kCubeHalf = 0.02;   // cube half size and resting height
 constexpr double kSuccess = 0.05;    // distance threshold
 constexpr double kEeStep = 0.05;     // metres per unit action
+constexpr double kFingerMax = 0.04;  // finger joint range [0, 0.04]
 constexpr double kFingerStep = 0.2;  // width change per unit action
 constexpr int kIkIterations = 30;
 constexpr double kIkDamping = 1e-2;  // damped least squares lambda
+constexpr double kServoRate = 50;    // PyBullet: kp * erp / dt = 0.1 * 1 / 0.002 per second
 // Gripper pointing down: 180 degrees about world x (wxyz).
 constexpr mjtNum kDown[4] = {0, 1, 0, 0};
 
@@ -29,6 +31,53 @@ int id_of(const mjModel* m, mjtObj type, const char* name) {
 double effective_friction(double table) { return std::min(0.5 * table, 10.0); }
 
 }  // namespace
+
+PandaIk::PandaIk(const mjModel* m) : data_(mj_makeData(m), mj_deleteData), jac_(6 * m->nv) {
+  site_ = id_of(m, mjOBJ_SITE, "grasptarget");
+  for (int k = 0; k < kArm; ++k) {
+    const int j = id_of(m, mjOBJ_JOINT, ("joint" + std::to_string(k + 1)).c_str());
+    arm_qpos_[k] = m->jnt_qposadr[j];
+    arm_dof_[k] = m->jnt_dofadr[j];
+    range_[k][0] = m->jnt_range[2 * j], range_[k][1] = m->jnt_range[2 * j + 1];
+  }
+}
+
+void PandaIk::solve(const mjModel* m, const mjtNum* qpos, const mjtNum target[3], mjtNum out[7]) {
+  mjData* ik = data_.get();
+  mju_copy(ik->qpos, qpos, m->nq);
+  for (int it = 0; it < kIkIterations; ++it) {
+    mj_kinematics(m, ik);
+    mj_comPos(m, ik);
+    // Error: position, and the rotation from the current to the target orientation (world).
+    mjtNum e[6], quat[4], local[3];
+    mju_sub3(e, target, ik->site_xpos + 3 * site_);
+    mju_mat2Quat(quat, ik->site_xmat + 9 * site_);
+    mju_subQuat(local, kDown, quat);
+    mju_rotVecMat(e + 3, local, ik->site_xmat + 9 * site_);
+    if (mju_norm3(e) < 1e-5 && mju_norm3(e + 3) < 1e-4) break;
+    mj_jacSite(m, ik, jac_.data(), jac_.data() + 3 * m->nv, site_);
+    // J is 6 x 7 over the arm dofs; dq = J^T (J J^T + lambda^2 I)^-1 e.
+    mjtNum j[6][kArm], a[36], y[6];
+    for (int r = 0; r < 6; ++r) {
+      for (int k = 0; k < kArm; ++k) j[r][k] = jac_[r * m->nv + arm_dof_[k]];
+    }
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < 6; ++c) {
+        a[6 * r + c] = mju_dot(j[r], j[c], kArm) + (r == c ? kIkDamping * kIkDamping : 0);
+      }
+    }
+    mju_cholFactor(a, 6, 0);
+    mju_cholSolve(y, a, e, 6);
+    for (int k = 0; k < kArm; ++k) {
+      mjtNum dq = 0;
+      for (int r = 0; r < 6; ++r) dq += j[r][k] * y[r];
+      mjtNum& q = ik->qpos[arm_qpos_[k]];
+      q = std::clamp(q + dq, range_[k][0], range_[k][1]);
+    }
+  }
+  mj_kinematics(m, ik);
+  for (int k = 0; k < kArm; ++k) out[k] = ik->qpos[arm_qpos_[k]];
+}
 
 Skill panda_skill(const mjModel* m, const mjData* d) {
   const int cube = mj_name2id(m, mjOBJ_GEOM, "object");
@@ -56,10 +105,9 @@ namespace {
 class PandaPush final : public SamiEnv {
  public:
   PandaPush(Spec spec, ModelPtr model, std::vector<TaskSet> sets, std::uint64_t seed)
-      : SamiEnv(std::move(spec), std::move(model), std::move(sets), seed),
-        ik_(mj_makeData(shared_.get()), mj_deleteData) {
+      : SamiEnv(std::move(spec), std::move(model), std::move(sets), seed), ik_(shared_.get()) {
     const mjModel* m = shared_.get();
-    site_ = id_of(m, mjOBJ_SITE, "grasptarget");
+    site_ = ik_.site();
     cube_body_ = id_of(m, mjOBJ_BODY, "object");
     table_ = id_of(m, mjOBJ_GEOM, "table");
     target_mocap_ = m->body_mocapid[id_of(m, mjOBJ_BODY, "target")];
@@ -67,14 +115,14 @@ class PandaPush final : public SamiEnv {
     cube_qpos_ = m->jnt_qposadr[cube_joint];
     cube_dof_ = m->jnt_dofadr[cube_joint];
     for (int k = 0; k < kArm; ++k) {
-      const int j = id_of(m, mjOBJ_JOINT, ("joint" + std::to_string(k + 1)).c_str());
-      arm_qpos_[k] = m->jnt_qposadr[j];
-      arm_dof_[k] = m->jnt_dofadr[j];
-      range_[k][0] = m->jnt_range[2 * j], range_[k][1] = m->jnt_range[2 * j + 1];
+      servo_qpos_[k] = ik_.arm_qpos(k);
+      servo_dof_[k] = ik_.arm_dof(k);
     }
-    finger_qpos_[0] = m->jnt_qposadr[id_of(m, mjOBJ_JOINT, "finger_joint1")];
-    finger_qpos_[1] = m->jnt_qposadr[id_of(m, mjOBJ_JOINT, "finger_joint2")];
-    jac_.resize(6 * m->nv);
+    for (int f = 0; f < 2; ++f) {
+      const int j = id_of(m, mjOBJ_JOINT, f == 0 ? "finger_joint1" : "finger_joint2");
+      servo_qpos_[kArm + f] = m->jnt_qposadr[j];
+      servo_dof_[kArm + f] = m->jnt_dofadr[j];
+    }
   }
 
   void reset(std::optional<std::uint64_t> seed) override {
@@ -89,7 +137,7 @@ class PandaPush final : public SamiEnv {
     body_mass_[cube_body_] = cell[1];
     for (int i = 0; i < 3; ++i) body_inertia_[3 * cube_body_ + i] = cell[1] * 2.667e-4;
     // Robot at the neutral pose, fingers closed, at rest; goal then cube on the table.
-    for (int k = 0; k < kArm; ++k) d->qpos[arm_qpos_[k]] = kNeutral[k];
+    for (int k = 0; k < kArm; ++k) d->qpos[servo_qpos_[k]] = kNeutral[k];
     goal_[0] = rng_.uniform(-kHalfRange, kHalfRange);
     goal_[1] = rng_.uniform(-kHalfRange, kHalfRange);
     goal_[2] = kCubeHalf;
@@ -99,8 +147,8 @@ class PandaPush final : public SamiEnv {
     cube[1] = rng_.uniform(-kHalfRange, kHalfRange);
     cube[2] = kCubeHalf;
     cube[3] = 1, cube[4] = cube[5] = cube[6] = 0;
-    for (int k = 0; k < kArm; ++k) d->ctrl[k] = kNeutral[k];
-    d->ctrl[kArm] = d->ctrl[kArm + 1] = 0;
+    for (int k = 0; k < kArm; ++k) target_[k] = kNeutral[k];
+    target_[kArm] = target_[kArm + 1] = 0;
     mj_forward(m, d);
     finish(false);
   }
@@ -113,16 +161,22 @@ class PandaPush final : public SamiEnv {
     for (int i = 0; i < 4; ++i) a[i] = std::clamp(action[i], -1.0, 1.0);
     // Arm: IK towards the measured end effector plus the commanded displacement.
     mjtNum target[3];
-    for (int i = 0; i < 3; ++i) target[i] = d->site_xpos[3 * site_] + kEeStep * a[i];
+    for (int i = 0; i < 3; ++i) target[i] = d->site_xpos[3 * site_ + i] + kEeStep * a[i];
     target[2] = std::max(target[2], 0.0);
-    solve_ik(target);
-    for (int k = 0; k < kArm; ++k) d->ctrl[k] = ik_->qpos[arm_qpos_[k]];
-    // Fingers: each takes half of the commanded width (the joint limits bound it).
-    const double width = d->qpos[finger_qpos_[0]] + d->qpos[finger_qpos_[1]] + kFingerStep * a[3];
-    d->ctrl[kArm] = d->ctrl[kArm + 1] = width / 2;
+    ik_.solve(m, d->qpos, target, target_);
+    // Fingers: each takes half of the commanded width, kept within the joint range (PyBullet's
+    // hard limits; MuJoCo's soft ones would yield to the 170 N motors).
+    const double width =
+        d->qpos[servo_qpos_[kArm]] + d->qpos[servo_qpos_[kArm + 1]] + kFingerStep * a[3];
+    target_[kArm] = target_[kArm + 1] = std::clamp(width / 2, 0.0, kFingerMax);
+    // PyBullet's motor law each substep: target velocity 50 (q* - q), force-limited.
     for (int k = 0; k < spec_.frame_skip; ++k) {
-      // Gravity (and Coriolis) compensation of the arm, as the real controller does.
-      for (int i = 0; i < kArm; ++i) d->qfrc_applied[arm_dof_[i]] = d->qfrc_bias[arm_dof_[i]];
+      for (int i = 0; i < kArm + 2; ++i) {
+        d->ctrl[i] = kServoRate * (target_[i] - d->qpos[servo_qpos_[i]]);
+        // Gravity and Coriolis held outside the force limit: PyBullet's motor is a velocity
+        // constraint that gravity cannot sag, a finite MuJoCo kv would.
+        d->qfrc_applied[servo_dof_[i]] = d->qfrc_bias[servo_dof_[i]];
+      }
       mj_step(m, d);
     }
     info_.steps++;
@@ -135,45 +189,6 @@ class PandaPush final : public SamiEnv {
   }
 
  private:
-  // Damped least squares on the grasp-target position and the pointing-down orientation,
-  // starting from the current joints; the result is left in ik_->qpos.
-  void solve_ik(const mjtNum target[3]) {
-    const mjModel* m = &model_;
-    mjData* ik = ik_.get();
-    mju_copy(ik->qpos, data_->qpos, m->nq);
-    for (int it = 0; it < kIkIterations; ++it) {
-      mj_kinematics(m, ik);
-      mj_comPos(m, ik);
-      mjtNum e[6], quat[4];
-      mju_sub3(e, target, ik->site_xpos + 3 * site_);
-      mju_mat2Quat(quat, ik->site_xmat + 9 * site_);
-      mju_subQuat(e + 3, kDown, quat);  // body-frame rotation from current to target
-      mjtNum world[3];
-      mju_rotVecMat(world, e + 3, ik->site_xmat + 9 * site_);
-      mju_copy3(e + 3, world);
-      if (mju_norm3(e) < 1e-5 && mju_norm3(e + 3) < 1e-4) break;
-      mj_jacSite(m, ik, jac_.data(), jac_.data() + 3 * m->nv, site_);
-      // J is 6 x 7 over the arm dofs; dq = J^T (J J^T + lambda^2 I)^-1 e.
-      mjtNum j[6][kArm], a[36], y[6];
-      for (int r = 0; r < 6; ++r) {
-        for (int k = 0; k < kArm; ++k) j[r][k] = jac_[r * m->nv + arm_dof_[k]];
-      }
-      for (int r = 0; r < 6; ++r) {
-        for (int c = 0; c < 6; ++c) {
-          a[6 * r + c] = mju_dot(j[r], j[c], kArm) + (r == c ? kIkDamping * kIkDamping : 0);
-        }
-      }
-      mju_cholFactor(a, 6, 0);
-      mju_cholSolve(y, a, e, 6);
-      for (int k = 0; k < kArm; ++k) {
-        mjtNum dq = 0;
-        for (int r = 0; r < 6; ++r) dq += j[r][k] * y[r];
-        mjtNum& q = ik->qpos[arm_qpos_[k]];
-        q = std::clamp(q + dq, range_[k][0], range_[k][1]);
-      }
-    }
-  }
-
   // Observation, success and skill labels of the current state; returns the goal distance.
   double finish(bool stepped) {
     const mjModel* m = &model_;
@@ -183,7 +198,7 @@ class PandaPush final : public SamiEnv {
     mj_objectVelocity(m, d, mjOBJ_SITE, site_, velocity, 0);
     o = std::copy_n(d->site_xpos + 3 * site_, 3, o);
     o = std::copy_n(velocity + 3, 3, o);
-    *o++ = d->qpos[finger_qpos_[0]] + d->qpos[finger_qpos_[1]];
+    *o++ = d->qpos[servo_qpos_[kArm]] + d->qpos[servo_qpos_[kArm + 1]];
     const mjtNum* cube = d->qpos + cube_qpos_;
     o = std::copy_n(cube, 3, o);
     // PyBullet's Euler angles (roll, pitch, yaw) of the cube quaternion (w, x, y, z).
@@ -220,11 +235,10 @@ class PandaPush final : public SamiEnv {
     return distance;
   }
 
-  std::unique_ptr<mjData, void (*)(mjData*)> ik_;  // scratch data for the IK iterations
-  std::vector<mjtNum> jac_;
+  PandaIk ik_;
   int site_ = 0, cube_body_ = 0, table_ = 0, target_mocap_ = 0, cube_qpos_ = 0, cube_dof_ = 0;
-  int arm_qpos_[kArm] = {}, arm_dof_[kArm] = {}, finger_qpos_[2] = {};
-  double range_[kArm][2] = {};
+  int servo_qpos_[kArm + 2] = {}, servo_dof_[kArm + 2] = {};  // arm joints, then the fingers
+  mjtNum target_[kArm + 2] = {};                              // joint targets of the servos
   mjtNum goal_[3] = {};
 };
 
