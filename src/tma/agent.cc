@@ -74,6 +74,8 @@ const std::vector<Embodiment>& embodiments() {
       {"fish", BodyKind::kSwimmer, 35 / kScale, 9 / kScale, false, 0, 1.0},
       {"amphibious_bipedal", BodyKind::kAmphibian, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
       {"classic_bipedal", BodyKind::kWalker, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
+      {"big_quadru", BodyKind::kWalker, 96 / kScale, 105 / kScale, false, 51 / kScale, 0},
+      {"wheel", BodyKind::kWalker, 20 / kScale, 30 / kScale, false, 10 / kScale, 0},
   };
   return table;
 }
@@ -113,6 +115,10 @@ void build_agent(std::string_view name, b2World& world, double x0, double y0, do
     build_amphibious_bipedal(agent, world, x0, y);
   } else if (name == "old_big_quadru") {
     build_old_big_quadru(agent, world, x0, y, stump_tracks);
+  } else if (name == "big_quadru") {
+    build_big_quadru(agent, world, x0, y, stump_tracks);
+  } else if (name == "wheel") {
+    build_wheel(agent, world, x0, y, stump_tracks);
   } else if (name == "spider") {
     build_spider(agent, world, x0, y, stump_tracks);
   } else if (name == "millipede") {

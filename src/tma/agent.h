@@ -114,6 +114,8 @@ void build_amphibious_bipedal(Agent&, b2World&, double x0, double y0);
 void build_old_big_quadru(Agent&, b2World&, double x0, double y0, bool critical_hull);
 void build_spider(Agent&, b2World&, double x0, double y0, bool critical_hull);
 void build_millipede(Agent&, b2World&, double x0, double y0);
+void build_big_quadru(Agent&, b2World&, double x0, double y0, bool critical_hull);
+void build_wheel(Agent&, b2World&, double x0, double y0, bool critical_hull);
 void build_profile_chimpanzee(Agent&, b2World&, double x0, double y0);
 void build_climbing_chimpanzee(Agent&, b2World&, double x0, double y0, bool legs);
 void build_fish(Agent&, b2World&, double x0, double y0);

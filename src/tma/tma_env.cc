@@ -53,10 +53,11 @@ TmaEnv::TmaEnv(const TmaOptions& options, std::shared_ptr<const Cppn> cppn)
   }
   water_.max_push = options_.water_clip;
   const bool parkour = options_.env == EnvId::kParkour;
-  // Lidar fan: Stump Tracks always looks down; Parkour defaults by body kind.
+  // Lidar fan: Stump Tracks always looks down; Parkour picks by body kind as the reference's
+  // run.py does (walkers down, climbers up, others keep the constructor default, full).
   std::string lidars = options_.lidars;
   if (lidars.empty()) {
-    lidars = !parkour || body_->kind == BodyKind::kWalker || body_->kind == BodyKind::kAmphibian
+    lidars = !parkour || body_->kind == BodyKind::kWalker
                  ? "down"
                  : (body_->kind == BodyKind::kClimber ? "up" : "full");
   }

@@ -300,4 +300,69 @@ void build_profile_chimpanzee(Agent& agent, b2World& world, double x0, double y0
   }
 }
 
+void build_big_quadru(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
+  agent.torque = 300;
+  agent.torque_penalty = 3.5e-4 / 2;
+  const double leg_down = 3 / kScale, leg_w = 10 / kScale, leg_h = 51 / kScale;
+  const double half_bottom = 96 / 2 / kScale;
+  const b2PolygonShape hull_shape =
+      build::pixel_polygon({{-46, 13}, {6, 13}, {50, 5}, {50, -12}, {-46, -12}});
+  b2Body* hull =
+      build::part(agent, world, at(x0, y0), 0, hull_shape, Fixture{.density = 5.0, .friction = 0.1},
+                  true, critical_hull, kHull1, kHull2);
+  agent.head = hull;
+  agent.pushed.push_back(hull);
+  const b2PolygonShape leg_shape = build::box(leg_w / 2, leg_h / 2);
+  const b2PolygonShape lower_shape = build::box(0.8 * leg_w / 2, leg_h / 2);
+  // Straight legs hanging from two points of the hull, world anchors.
+  for (double x_anchor : {-0.7, 0.5}) {
+    const double ax = x0 + x_anchor * half_bottom;
+    for (double i : {-1.0, 1.0}) {
+      b2Body* leg = build::part(agent, world, at(ax, y0 - leg_h / 2 - leg_down), 0, leg_shape,
+                                Fixture{}, false, false, leg1(i), leg2(i));
+      build::motor(agent, build::joint(world, hull, leg, at(ax, y0 - leg_down), -0.8, 1.1, true),
+                   4);
+      b2Body* lower = build::part(agent, world, at(ax, y0 - leg_h * 1.5 - leg_down), 0, lower_shape,
+                                  Fixture{}, true, false, leg1(i), leg2(i));
+      build::motor(agent,
+                   build::joint(world, leg, lower, at(ax, y0 - leg_down - leg_h), -1.6, -0.1, true),
+                   6, lower, 1.0);
+    }
+  }
+}
+
+void build_wheel(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
+  agent.torque = 500;
+  agent.torque_penalty = 3.5e-4 / 2;
+  agent.remove_head_angle = true;
+  const double leg_w = 4 / kScale, leg_h = 10 / kScale, half = 10 / kScale;
+  const Rgb body1{0.5f, 0.2f, 0.4f}, body2{0.3f, 0.1f, 0.2f};
+  const Rgb limb1{0.7f, 0.4f, 0.6f}, limb2{0.5f, 0.3f, 0.4f};
+  const b2PolygonShape main_shape =
+      build::pixel_polygon({{-10, 10}, {10, 10}, {10, -10}, {-10, -10}});
+  b2Body* main =
+      build::part(agent, world, at(x0, y0), 0, main_shape, Fixture{.density = 5.0, .friction = 0.1},
+                  true, critical_hull, body1, body2);
+  agent.head = main;
+  agent.pushed.push_back(main);
+  const b2PolygonShape leg_shape = build::box(leg_w / 2, leg_h / 2);
+  const b2PolygonShape lower_shape = build::box(0.8 * leg_w / 2, leg_h / 2);
+  // Four two-part legs in a cross: down, up, left, right.
+  const double dirs[4][3] = {{0, -1, 0}, {0, 1, 0}, {-1, 0, kPi / 2}, {1, 0, kPi / 2}};
+  for (const auto& d : dirs) {
+    const double lx = x0 + d[0] * (leg_h / 2 + half), ly = y0 + d[1] * (leg_h / 2 + half);
+    b2Body* leg = build::part(agent, world, at(lx, ly), d[2], leg_shape, Fixture{}, false, false,
+                              limb1, limb2);
+    build::motor(
+        agent,
+        build::joint(world, main, leg, at(x0 + d[0] * half, y0 + d[1] * half), -0.8, 1.1, true), 4);
+    b2Body* lower = build::part(agent, world, at(lx + d[0] * leg_h, ly + d[1] * leg_h), d[2],
+                                lower_shape, Fixture{}, true, false, limb1, limb2);
+    build::motor(agent,
+                 build::joint(world, leg, lower, at(lx + d[0] * leg_h / 2, ly + d[1] * leg_h / 2),
+                              -1.6, -0.1, true),
+                 6, lower, 1.0);
+  }
+}
+
 }  // namespace cradle::tma

@@ -31,6 +31,8 @@ constexpr Sizes kSizes[] = {
     {"climbing_profile_chimpanzee", 42, 54, 12},
     {"climbing_chest_profile_chimpanzee", 32, 44, 8},
     {"fish", 26, 38, 4},
+    {"big_quadru", 34, 46, 8},
+    {"wheel", 34, 46, 8},
 };
 
 TmaEnv make(EnvId env, const std::string& body) {
