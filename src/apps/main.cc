@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_test_installation(app);
   cradle::apps::register_train(app);
   cradle::apps::register_illustrate(app);
+  cradle::apps::register_sami(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
