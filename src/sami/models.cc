@@ -472,11 +472,8 @@ std::string panda() {
   XmlWriter x;
   x.open("mujoco", {{"model", "panda_push"}});
   x.leaf("compiler", {{"angle", "radian"}, {"coordinate", "local"}, {"inertiafromgeom", "false"}});
-  // Implicit in velocity: the stiff velocity servos below stay stable at 2 ms.
-  x.leaf("option", {{"timestep", "0.002"},
-                    {"gravity", "0 0 -9.81"},
-                    {"integrator", "implicit"},
-                    {"cone", "elliptic"}});
+  // Elliptic friction cones: the pyramidal ones let a cube sink through a table of friction 10.
+  x.leaf("option", {{"timestep", "0.002"}, {"gravity", "0 0 -9.81"}, {"cone", "elliptic"}});
   x.open("default");
   // Arm links are visual only; the hand and the fingers (contype 2) touch the cube and table.
   // Stiff contacts (time constant 2 timesteps) so a resting cube sinks well under 1 mm.

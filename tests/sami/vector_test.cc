@@ -1,4 +1,6 @@
 // Vector over task sets (one sub-env per set, one shared model) and rendering.
+#include "sami/vector.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -6,7 +8,6 @@
 
 #include "core/error.h"
 #include "sami/render.h"
-#include "sami/vector.h"
 
 namespace cradle::sami {
 namespace {
