@@ -14,5 +14,6 @@ void register_test_installation(CLI::App& app);
 void register_train(CLI::App& app);
 void register_illustrate(CLI::App& app);
 void register_tma(CLI::App& app);
+void register_sami(CLI::App& app);
 
 }  // namespace cradle::apps

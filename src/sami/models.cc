@@ -36,12 +36,12 @@ void light(XmlWriter& x) {
                    {"castshadow", "false"}});
 }
 
-// A tracking camera at the side of the robot, looking at it horizontally.
-void track_camera(XmlWriter& x, double distance, double height) {
+// A tracking camera beside the robot, looking at it horizontally (pitch 0) or from above.
+void track_camera(XmlWriter& x, double distance, double height, bool from_above = false) {
   x.leaf("camera", {{"name", "track"},
                     {"mode", "trackcom"},
                     {"pos", nums({0, -distance, height})},
-                    {"xyaxes", "1 0 0 0 0 1"}});
+                    {"xyaxes", from_above ? "1 0 0 0 .5 .866" : "1 0 0 0 0 1"}});
 }
 
 // Half-Cheetah (sami_models.md §1.2): capsules r 0.046 given as pos, half-length and a rotation
@@ -165,7 +165,7 @@ std::string ant() {
                   {"condim", "3"},
                   {"material", "grid"}});
   x.open("body", {{"name", "torso"}, {"pos", "0 0 .75"}});
-  track_camera(x, 4, 0.5);
+  track_camera(x, 3.5, 2, true);
   x.leaf("geom", {{"name", "torso_geom"}, {"type", "sphere"}, {"pos", "0 0 0"}, {"size", ".25"}});
   x.leaf("joint", {{"name", "root"},
                    {"type", "free"},
@@ -388,7 +388,7 @@ std::string humanoid() {
                      {"armature", armature}});
   };
   x.open("body", {{"name", "torso"}, {"pos", "0 0 .105"}});
-  track_camera(x, 4, 0.5);
+  track_camera(x, 3.5, 2, true);
   x.leaf("joint", {{"name", "root"},
                    {"type", "free"},
                    {"armature", "0"},
@@ -472,11 +472,8 @@ std::string panda() {
   XmlWriter x;
   x.open("mujoco", {{"model", "panda_push"}});
   x.leaf("compiler", {{"angle", "radian"}, {"coordinate", "local"}, {"inertiafromgeom", "false"}});
-  // Implicit in velocity: the stiff velocity servos below stay stable at 2 ms.
-  x.leaf("option", {{"timestep", "0.002"},
-                    {"gravity", "0 0 -9.81"},
-                    {"integrator", "implicit"},
-                    {"cone", "elliptic"}});
+  // Elliptic friction cones: the pyramidal ones let a cube sink through a table of friction 10.
+  x.leaf("option", {{"timestep", "0.002"}, {"gravity", "0 0 -9.81"}, {"cone", "elliptic"}});
   x.open("default");
   // Arm links are visual only; the hand and the fingers (contype 2) touch the cube and table.
   // Stiff contacts (time constant 2 timesteps) so a resting cube sinks well under 1 mm.

@@ -1,5 +1,5 @@
 // Single-core throughput of a SaMI env against the bare mj_steps it contains, measured in one run
-// with interleaved blocks so that both see the same machine load.
+// with interleaved blocks so that both see the same machine load, in thread CPU time.
 #pragma once
 
 #include <cstdint>
