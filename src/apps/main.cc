@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   cradle::apps::register_test_installation(app);
   cradle::apps::register_train(app);
   cradle::apps::register_illustrate(app);
+  cradle::apps::register_tma(app);
+  cradle::apps::register_sami(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -145,4 +145,6 @@ PYBIND11_MODULE(_cradle, m) {
 
   cradle::python::bind_env(m);
   cradle::python::bind_learn(m);
+  cradle::python::bind_tma(m);
+  cradle::python::bind_sami(m);
 }
