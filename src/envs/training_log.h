@@ -13,24 +13,20 @@
 
 namespace cradle::envs {
 
-// Score of one episode: self-touch (|right| + |left|) / 68 geoms; hand regard the mean over the
-// four eye-hand pairs of the fraction of steps in view; none: no score (NaN).
-double episode_score(Behavior behavior, const Info& info, int steps);
-
 class TrainingLog {
  public:
   // append = false starts a new log (a new training run); true continues one (resume).
-  TrainingLog(std::filesystem::path file, Behavior behavior, int save_every, bool append = false);
+  TrainingLog(std::filesystem::path file, int save_every, bool append = false);
   ~TrainingLog();
-  // Records one finished episode of `steps` env steps. Thread-safe.
-  void record(const Info& info, int steps);
+  // Records one finished episode of `steps` env steps with its task's score (NaN: none).
+  // Thread-safe.
+  void record(const Info& info, int steps, double score);
   void flush();
   int episodes() const;
   const std::filesystem::path& file() const { return file_; }
 
  private:
   std::filesystem::path file_;
-  Behavior behavior_;
   int save_every_;
   mutable std::mutex mutex_;
   JsonlWriter writer_;

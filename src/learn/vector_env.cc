@@ -7,7 +7,6 @@
 #include <thread>
 
 #include "core/rng.h"
-#include "envs/babybench.h"
 
 namespace cradle::learn {
 namespace {
@@ -151,23 +150,6 @@ void ThreadedVecEnv::gather(int key_index, std::span<std::uint8_t> out) const {
   for (size_t i = 0; i < envs_.size(); ++i) {
     std::ranges::copy(envs_[i]->observation().u8(key_index), out.data() + i * size);
   }
-}
-
-std::unique_ptr<ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
-                                                       int threads, bool training,
-                                                       std::uint64_t seed) {
-  if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
-  // One compiled model for all; one training log shared by all (it is thread-safe).
-  const auto assets = envs::make_assets(config);
-  const std::shared_ptr<envs::TrainingLog> log = training ? envs::start_training(*assets) : nullptr;
-  return std::make_unique<ThreadedVecEnv>(
-      num_envs,
-      [&](int i) {
-        auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
-        if (log) env->attach_log(log);
-        return env;
-      },
-      threads);
 }
 
 }  // namespace cradle::learn

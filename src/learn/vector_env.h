@@ -73,11 +73,4 @@ class ThreadedVecEnv final : public VecEnv {
   std::vector<std::uint8_t> ended_;  // episode ended in the last call: reset on the next step
 };
 
-// BabyBench envs sharing one set of assets (one compiled model; each env still holds its own
-// mjData, about 300 MB with the reference scenes' njmax = 5000). training = true prepares
-// <save_dir> as envs::make_env does and attaches one shared training log to every env.
-std::unique_ptr<ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
-                                                       int threads, bool training,
-                                                       std::uint64_t seed);
-
 }  // namespace cradle::learn
