@@ -8,6 +8,18 @@ ENVS ?= 2
 EPISODES ?= 2
 INTRINSIC ?= body_part_novelty
 RESULTS ?= results/make_run
+# `make test SANITIZE=1`: AddressSanitizer + UndefinedBehaviorSanitizer build of the C++ suite in
+# build-asan (no Python module: the interpreter is not instrumented).
+SANITIZE ?= 0
+ifeq ($(SANITIZE),1)
+BUILD_DIR := build-asan
+BUILD_TYPE := RelWithDebInfo
+SAN := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+CMAKE_EXTRA := -DCMAKE_CXX_FLAGS="$(SAN)" -DCMAKE_C_FLAGS="$(SAN)" \
+  -DCMAKE_EXE_LINKER_FLAGS="$(SAN)" -DCMAKE_SHARED_LINKER_FLAGS="$(SAN)" -DCRADLE_PYTHON=OFF
+export ASAN_OPTIONS ?= detect_leaks=0:abort_on_error=1
+export UBSAN_OPTIONS ?= print_stacktrace=1
+endif
 
 .PHONY: all deps configure build run test install install-python format clean
 
@@ -17,7 +29,7 @@ deps:
 	@scripts/install-deps.sh
 
 configure: deps
-	@cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) >/dev/null
+	@cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(CMAKE_EXTRA) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)

@@ -125,6 +125,21 @@ class _FallbackEnv:
 _EnvBase = _gymnasium.Env if _gymnasium is not None else _FallbackEnv
 
 
+def _check_actions(actions, shape, what):
+    """actions as a float64 array of `shape`; a one-line ValueError for strings, objects, another
+    shape or non-finite values (which MuJoCo would silently zero)."""
+    a = np.asarray(actions)
+    if a.dtype.kind not in "fiu":
+        raise ValueError(f"{what} must hold numbers, got dtype {a.dtype}")
+    if a.shape != tuple(shape):
+        raise ValueError(f"{what} has shape {a.shape}, expected {tuple(shape)}")
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if not np.isfinite(a).all():
+        bad = np.argwhere(~np.isfinite(a))[0]
+        raise ValueError(f"{what} {tuple(int(i) for i in bad)} is {a[tuple(bad)]}; expected finite values")
+    return a
+
+
 class BabyBenchEnv(_EnvBase):
     """A BabyBench env (behaviour from the config) stepped in C++.
 
@@ -157,6 +172,7 @@ class BabyBenchEnv(_EnvBase):
         # As the reference's env.config: every key as a plain dict (parsed, defaults filled in).
         self.config = json.loads(self._config.to_json())
         self.training = bool(training)
+        self._closed = False
         self._core = _cradle.Env(self._config, self.training, int(seed), bool(copy_observations))
         self.render_mode = render_mode
         self.camera = camera
@@ -198,6 +214,10 @@ class BabyBenchEnv(_EnvBase):
         np_random); None continues its stream. `options` is accepted and ignored."""
         if seed is not None and (not isinstance(seed, numbers.Integral) or seed < 0):
             raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
+        if self._closed:
+            raise ValueError("reset() after close(): this env is closed; make a new one")
+        if seed is not None and seed > 2**64 - 1:
+            raise ValueError(f"seed must be at most 2**64 - 1, not {seed!r}")
         super().reset(seed=seed)
         return self._core.reset(None if seed is None else int(seed))
 
@@ -205,7 +225,9 @@ class BabyBenchEnv(_EnvBase):
         """One env step: (observation, reward, terminated, truncated, info). The action is any
         array-like of action_space.shape (converted to float64); the GIL is released while C++
         steps. truncated is True at max_episode_steps (the reference's TimeLimit)."""
-        return self._core.step(action)
+        if self._closed:
+            raise ValueError("step() after close(): this env is closed; make a new one")
+        return self._core.step(_check_actions(action, self.action_space.shape, "action"))
 
     def render(self):
         """An RGB image (render_size x render_size x 3, uint8) of `camera` for
@@ -218,6 +240,7 @@ class BabyBenchEnv(_EnvBase):
     def close(self):
         """Records the last (partial) episode in the training log and flushes it."""
         self._core.close()
+        self._closed = True
 
     def __repr__(self):
         return f"<BabyBenchEnv behavior={self.behavior!r} training={self.training}>"

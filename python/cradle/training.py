@@ -143,6 +143,10 @@ def _log_file(path):
     return path
 
 
+def _is_count(value):
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 0
+
+
 def load_training_log(path, extras=False):
     """The reference's training.pkl structure (a list of dicts, one per recorded episode) from
     Cradle's logs/training.jsonl, a save_dir, or a reference training.pkl.
@@ -164,11 +168,18 @@ def load_training_log(path, extras=False):
         if not line.strip():
             continue
         try:
-            entries.append(json.loads(line))
+            entry = json.loads(line)
         except json.JSONDecodeError:
             if number == len(lines):  # an unterminated last line (a crash mid-write)
                 break
             raise ValueError(f"{file}:{number}: not a JSON line") from None
+        # Valid JSON that is no entry (42, null, a list, wrong types) is refused with its line.
+        if not isinstance(entry, dict) or not _is_count(entry.get("steps")):
+            raise ValueError(f"{file}:{number}: expected an entry object with integer 'steps' >= 0")
+        for key in ("right_hand_touches", "left_hand_touches"):
+            if key in entry and not (isinstance(entry[key], list) and all(map(_is_count, entry[key]))):
+                raise ValueError(f"{file}:{number}: '{key}' must be a list of geom ids (integers >= 0)")
+        entries.append(entry)
     out = []
     for entry in entries:
         if "right_hand_touches" in entry:

@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _cradle
 from . import spaces
-from .env import _gymnasium, load_config
+from .env import _check_actions, _gymnasium, load_config
 
 if _gymnasium is not None:
     import gymnasium.vector as _gym_vector
@@ -82,9 +82,11 @@ class VectorEnv(_VectorBase):
     def reset(self, *, seed=None, options=None):
         """Resets every env: (observations, infos). Env i gets the i-th seed derived from `seed`
         (an int; None: the next seed of the vector's own generator)."""
+        if self.closed:
+            raise ValueError("reset() after close(): this vector is closed; make a new one")
         if seed is None:
             seed = int(self._seeds.integers(2**63))
-        elif not isinstance(seed, numbers.Integral) or seed < 0:
+        elif not isinstance(seed, numbers.Integral) or seed < 0 or seed > 2**64 - 1:
             raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
         else:
             self._np_random = np.random.default_rng(seed)
@@ -93,7 +95,9 @@ class VectorEnv(_VectorBase):
     def step(self, actions):
         """actions: (num_envs, action dim). Returns (observations, rewards, terminated, truncated,
         infos); the C++ envs step in parallel with the GIL released."""
-        return self._core.step(actions)
+        if self.closed:
+            raise ValueError("step() after close(): this vector is closed; make a new one")
+        return self._core.step(_check_actions(actions, self.action_space.shape, "actions"))
 
     def render(self):
         return None

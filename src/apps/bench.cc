@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
@@ -148,7 +149,7 @@ void register_bench(CLI::App& app) {
   cmd->add_option("--config", opts->config, "BabyBench YAML config");
   cmd->add_option("--env", opts->env, "MIMo sample env (MIMoReach-v0, ...; all: every one)");
   cmd->add_option("--steps", opts->steps, "Env steps to time")->check(CLI::Range(1, 100000000));
-  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy");
+  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy")->check(kSeed);
   cmd->add_flag("--json", opts->json, "Print one JSON object");
   cmd->callback([opts] {
     if (opts->config.empty() == opts->env.empty()) {

@@ -13,5 +13,7 @@ void register_evaluate(CLI::App& app);
 void register_test_installation(CLI::App& app);
 void register_train(CLI::App& app);
 void register_illustrate(CLI::App& app);
+void register_tma(CLI::App& app);
+void register_sami(CLI::App& app);
 
 }  // namespace cradle::apps

@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
 #include "eval/evaluation.h"
@@ -38,7 +39,7 @@ void register_evaluate(CLI::App& app) {
   cmd->add_option("--duration", opts->duration, "Env steps per episode")
       ->check(CLI::Range(1, 100000000));
   cmd->add_flag("--render,!--no-render", opts->render, "Write a video per episode (default on)");
-  cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i");
+  cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i")->check(kSeed);
   cmd->add_option("--policy", opts->policy,
                   "Checkpoint of a trained policy (cradle train); default: random actions");
   cmd->add_option("--video-format", opts->format, "Video container")

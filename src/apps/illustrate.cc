@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/rng.h"
@@ -323,8 +324,9 @@ void register_illustrate(CLI::App& app) {
                 "Catch: per-episode error of the head's aim at the ball");
   cmd->add_flag("--palm_up", o->palm_up,
                 "Catch: wrist pinned palm-up as in MIMo's first catch scene");
-  cmd->add_option("--envs", o->envs, "Parallel training envs (one thread each)");
-  cmd->add_option("--seed", o->seed, "Seed of the envs and the learner");
+  cmd->add_option("--envs", o->envs, "Parallel training envs (one thread each)")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--seed", o->seed, "Seed of the envs and the learner")->check(kSeed);
   cmd->add_option("--hp", o->hp, "Hyperparameter override name=value (repeatable)");
   cmd->callback([o] { run(*o); });
 }

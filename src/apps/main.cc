@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 
 #include "apps/commands.h"
 #include "core/error.h"
@@ -34,10 +35,17 @@ int main(int argc, char** argv) {
   cradle::apps::register_test_installation(app);
   cradle::apps::register_train(app);
   cradle::apps::register_illustrate(app);
+  cradle::apps::register_tma(app);
+  cradle::apps::register_sami(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version print and succeed; a flag error is one line and exit 1.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::string message = e.what();
+    for (char& ch : message) ch = ch == '\n' ? ' ' : ch;
+    std::fprintf(stderr, "cradle: error: %s (see --help)\n", message.c_str());
+    return 1;
   } catch (const cradle::UserError& e) {
     std::fprintf(stderr, "cradle: error: %s\n", e.what());
     return 1;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/jsonl.h"
@@ -29,7 +30,7 @@ void register_random(CLI::App& app) {
   cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--train_for,--train-for", opts->train_for, "Env steps to run")
       ->check(CLI::Range(1L, 1000000000L));
-  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy");
+  cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy")->check(kSeed);
   cmd->callback([opts] {
     Config config = load_config(opts->config);
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
@@ -46,7 +47,7 @@ void register_train(CLI::App& app) {
          "--update-threads", opts->train.update_threads,
          "LibTorch threads for gradient updates (0: every core for image policies, 1 otherwise)")
       ->check(CLI::Range(0, 1024));
-  cmd->add_option("--seed", opts->train.seed, "Seed of everything");
+  cmd->add_option("--seed", opts->train.seed, "Seed of everything")->check(kSeed);
   cmd->add_flag("--resume", opts->train.resume, "Continue from <save_dir>/checkpoints/latest.ckpt");
   cmd->add_flag("--randomize-start", opts->train.randomize_start,
                 "Random start postures within joint limits");
@@ -61,7 +62,11 @@ void register_train(CLI::App& app) {
   cmd->add_flag(
       "--no-eval-video", [opts](std::int64_t) { opts->train.eval_render = false; },
       "Evaluate without writing videos");
-  cmd->callback([opts] {
+  cmd->callback([opts, cmd] {
+    // --resume continues the checkpoint's algorithm; an --algo that contradicts it is refused.
+    if (opts->train.resume && cmd->get_option("--algo")->count() == 0) {
+      opts->train.algorithm.clear();
+    }
     Config config = load_config(opts->config);
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     for (const std::string& kv : opts->hp) {

@@ -2,6 +2,8 @@
 // field and limits; parsing, YAML output, JSON output and the key list all walk that table.
 #include "core/config.h"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -130,6 +132,8 @@ struct Range {
 constexpr double kIntMax = std::numeric_limits<int>::max();
 constexpr Range kAny{};
 constexpr Range kPositiveInt{1.0, kIntMax};
+constexpr double kMinTouchScale = 0.25;              // ~16 x the reference skin's 17,049 sensors
+constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;  // configs are a few KiB
 
 // Calls visit(key, field, range) for every key, in to_yaml order. C is Config or const Config.
 template <typename C, typename Visit>
@@ -138,7 +142,8 @@ void for_each_field(C& c, Visit&& visit) {
   visit("behavior", c.behavior, kAny);
   visit("scene", c.scene, kAny);
   visit("max_episode_steps", c.max_episode_steps, kPositiveInt);
-  visit("frame_skip", c.frame_skip, kPositiveInt);
+  // At most 100 physics steps per env step (beyond that an env step runs for seconds).
+  visit("frame_skip", c.frame_skip, Range{1.0, 100.0});
   visit("render_size", c.render_size, Range{16.0, 4096.0});
   visit("save_logs_every", c.save_logs_every, kPositiveInt);
   visit("proprio_velocity", c.proprio_velocity, kAny);
@@ -149,6 +154,7 @@ void for_each_field(C& c, Visit&& visit) {
   visit("vision_active", c.vision_active, kAny);
   visit("vision_resolution", c.vision_resolution, Range{1.0, 1024.0});
   visit("touch_active", c.touch_active, kAny);
+  // 0 turns touch off; with touch on, parse_config also bounds it (kMinTouchScale..100).
   visit("touch_scale", c.touch_scale, Range{0.0});
   visit("touch_function", c.touch_function, kAny);
   visit("touch_response", c.touch_response, kAny);
@@ -534,6 +540,20 @@ Config parse_config(std::string_view yaml_text, std::string_view source) {
     }
     reader->second(Site{source, key}, item.second);
   }
+  // Keys that only make sense together.
+  // The skin has ~1 / touch_scale^2 sensors: below kMinTouchScale it outgrows memory and time.
+  if (config.touch_active && config.touch_scale > 0 &&
+      (config.touch_scale < kMinTouchScale || config.touch_scale > 100)) {
+    fail(std::string(source) + ": key 'touch_scale' must be 0 (touch off) or between " +
+         shortest_number(kMinTouchScale) + " and 100 when touch_active is True, got " +
+         shortest_number(config.touch_scale));
+  }
+  bool actuated = false;
+  for (const bool on : config.act_groups.flags) actuated = actuated || on;
+  if (!actuated) {
+    fail(std::string(source) +
+         ": no actuated joints: every act_* key is False; set at least one to True");
+  }
   return config;
 }
 
@@ -547,14 +567,32 @@ Config load_config(const std::filesystem::path& file) {
   if (std::filesystem::is_directory(status)) {
     fail(source + ": cannot read config file: it is a directory");
   }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
+  // Devices (/dev/zero) could feed bytes forever: the size is capped.
+  // POSIX reads, so a failing read (e.g. /proc/self/mem, EIO) is an error, not an empty file.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
     fail(source + ": cannot read config file: " + std::generic_category().message(errno));
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) fail(source + ": cannot read config file: read error");
-  return parse_config(text.str(), source);
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int error = errno;
+      ::close(fd);
+      fail(source + ": cannot read config file: " + std::generic_category().message(error));
+    }
+    if (n == 0) break;
+    text.append(buffer, static_cast<size_t>(n));
+    if (text.size() > kMaxConfigBytes) {
+      ::close(fd);
+      fail(source + ": cannot read config file: larger than " +
+           std::to_string(kMaxConfigBytes >> 10) + " KiB");
+    }
+  }
+  ::close(fd);
+  return parse_config(text, source);
 }
 
 std::string to_yaml(const Config& config) {

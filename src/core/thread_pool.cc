@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string>
+#include <system_error>
+
+#include "core/error.h"
 
 namespace cradle {
 namespace {
@@ -37,10 +41,19 @@ bool spin_until(Ready ready) {
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   workers_.reserve(threads - 1);
-  for (int p = 1; p < threads; ++p) workers_.emplace_back([this, p] { worker_loop(p); });
+  try {
+    for (int p = 1; p < threads; ++p) workers_.emplace_back([this, p] { worker_loop(p); });
+  } catch (const std::system_error& error) {
+    // No destructor runs for a half-built pool: stop and join the workers started so far.
+    stop_workers();
+    throw UserError("cannot start " + std::to_string(threads) + " threads (" + error.what() +
+                    "); use fewer envs or --threads");
+  }
 }
 
-ThreadPool::~ThreadPool() {
+ThreadPool::~ThreadPool() { stop_workers(); }
+
+void ThreadPool::stop_workers() {
   {
     std::lock_guard lock(mutex_);
     stop_.store(true, std::memory_order_relaxed);
@@ -48,6 +61,7 @@ ThreadPool::~ThreadPool() {
   }
   start_cv_.notify_all();
   for (std::thread& worker : workers_) worker.join();
+  workers_.clear();
 }
 
 void ThreadPool::run(int n, Task task) {

@@ -19,6 +19,7 @@ namespace cradle {
 class ThreadPool {
  public:
   // `threads` participants including the caller (<= 0: hardware concurrency; 1: run inline).
+  // UserError when the system cannot start that many threads (those started are joined).
   explicit ThreadPool(int threads);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
@@ -46,6 +47,8 @@ class ThreadPool {
   // Runs participant p's share of the current loop, catching the first exception.
   void work(int participant);
   void worker_loop(int participant);
+  // Wakes every worker to exit and joins them.
+  void stop_workers();
 
   std::vector<std::thread> workers_;
   // The current loop, published by bumping generation_.

@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "core/error.h"
+#include "envs/action_check.h"
 
 namespace cradle::envs {
 namespace {
@@ -157,18 +158,25 @@ const ObservationLayout* BabyBenchEnv::layout(std::string_view key) const {
 }
 
 void BabyBenchEnv::close() {
-  if (log_ && steps_ > 0) log_->record(info_, steps_, score());
+  if (log_ && steps_ > 0 && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
+  skip_record_ = true;
   if (log_) log_->flush();
   log_.reset();
 }
 
-std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets) {
+void BabyBenchEnv::end_episode() {
+  if (log_ && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
+  skip_record_ = true;
+}
+
+std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log) {
   const Config& config = assets.config;
   const std::filesystem::path dir = config.save_dir;
   scene::write_scene(assets.scene, dir);
   std::error_code ec;
   std::filesystem::create_directories(dir / "videos", ec);
-  return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.save_logs_every);
+  return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.save_logs_every,
+                                       continue_log >= 0, std::max(continue_log, 0L));
 }
 
 std::unique_ptr<BabyBenchEnv> make_env(const Config& config, bool training, std::uint64_t seed) {
@@ -186,7 +194,8 @@ int BabyBenchEnv::key_index(std::string_view key) const {
 }
 
 void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
-  if (log_) log_->record(info_, steps_, score());
+  if (log_ && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
+  skip_record_ = false;
   if (seed) rng_.seed_with(*seed);
   sim_.reset();
   sim_.restore(assets_->settled);
@@ -215,6 +224,7 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
 }
 
 StepResult BabyBenchEnv::step(std::span<const double> action) {
+  check_finite_actions(action);
   const Clock::time_point start = Clock::now();
   sim_.step(action);
   profile_.physics += seconds(Clock::now() - start);

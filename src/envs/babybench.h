@@ -47,8 +47,9 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
                                                    const std::filesystem::path& scene_file);
 
 // Prepares <save_dir> for a training run (scene.xml, logs/, videos/) and opens a new training log
-// there, for one env or for every env of a vector.
-std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets);
+// there, for one env or for every env of a vector. continue_log >= 0: continues the log, which
+// holds that many entries (a resumed run).
+std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log = -1);
 
 // The skin's layout: 1 or 3 values per sensor; groupings "geom" and "body" (the geom and body
 // each sensor sits on; a body's sensors are contiguous).
@@ -80,7 +81,17 @@ class BabyBenchEnv final : public Env {
 
   // Training mode: every reset records the episode that just ended (the first reset records a
   // 0-step entry, as the reference does); close() records the last, partial one.
-  void attach_log(std::shared_ptr<TrainingLog> log) { log_ = std::move(log); }
+  // `slot` (the env's index in a vector) orders its entries in the log (TrainingLog::set_slots).
+  void attach_log(std::shared_ptr<TrainingLog> log, int slot = -1) {
+    log_ = std::move(log);
+    log_slot_ = slot;
+  }
+  const std::shared_ptr<TrainingLog>& log() const { return log_; }
+  // Records the current episode now (e.g. cut short at a checkpoint); the next reset or close
+  // then records nothing for it.
+  void end_episode();
+  // The next reset records nothing (a resumed run: the episode before it was never this env's).
+  void skip_next_record() { skip_record_ = true; }
   // Random start postures: every reset draws each free MIMo joint (not held by an active joint
   // equality) uniformly within its range before the random start actions (reset option
   // "randomize_start" = 1).
@@ -124,6 +135,8 @@ class BabyBenchEnv final : public Env {
   std::unique_ptr<Task> task_;
   HandContacts contacts_;
   std::shared_ptr<TrainingLog> log_;
+  int log_slot_ = -1;
+  bool skip_record_ = false;  // the current episode is already recorded (or not this env's)
   DictSpace observation_space_;
   ObservationBuffers obs_;
   const int proprio_index_, touch_index_, eye_left_index_, eye_right_index_, vestibular_index_;

@@ -1,11 +1,15 @@
 #include "envs/training_log.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace cradle::envs {
 
-TrainingLog::TrainingLog(std::filesystem::path file, int save_every, bool append)
-    : file_(std::move(file)), save_every_(save_every), writer_(file_, append) {}
+TrainingLog::TrainingLog(std::filesystem::path file, int save_every, bool append, long episodes)
+    : file_(std::move(file)),
+      save_every_(save_every),
+      writer_(file_, append),
+      episodes_(append ? episodes : 0) {}
 
 TrainingLog::~TrainingLog() {
   try {
@@ -15,23 +19,46 @@ TrainingLog::~TrainingLog() {
   }
 }
 
-void TrainingLog::record(const Info& info, int steps, double score) {
+void TrainingLog::record(const Info& info, int steps, double score, int slot) {
   nlohmann::json entry = info.to_json();
   entry["steps"] = steps;
   if (!std::isnan(score)) entry["score"] = score;
   std::lock_guard lock(mutex_);
   entry["wall_time"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // Ordered mode: wait for commit() (slot order); otherwise written now.
+  if (slot >= 0 && slot < static_cast<int>(pending_.size())) {
+    pending_[slot].push_back(std::move(entry));
+    return;
+  }
+  write_locked(entry);
+}
+
+void TrainingLog::write_locked(const nlohmann::json& entry) {
   writer_.write(entry);
   if (++episodes_ % save_every_ == 0) writer_.flush();
 }
 
+void TrainingLog::set_slots(int slots) {
+  std::lock_guard lock(mutex_);
+  pending_.resize(std::max(slots, 0));
+}
+
+void TrainingLog::commit() {
+  std::lock_guard lock(mutex_);
+  for (auto& entries : pending_) {
+    for (const nlohmann::json& entry : entries) write_locked(entry);
+    entries.clear();
+  }
+}
+
 void TrainingLog::flush() {
+  commit();
   std::lock_guard lock(mutex_);
   writer_.flush();
 }
 
-int TrainingLog::episodes() const {
+long TrainingLog::episodes() const {
   std::lock_guard lock(mutex_);
   return episodes_;
 }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <filesystem>
 #include <mutex>
+#include <vector>
 
 #include "core/config.h"
 #include "core/jsonl.h"
@@ -15,14 +16,23 @@ namespace cradle::envs {
 
 class TrainingLog {
  public:
-  // append = false starts a new log (a new training run); true continues one (resume).
-  TrainingLog(std::filesystem::path file, int save_every, bool append = false);
+  // append = false starts a new log (a new training run); true continues one (resume) that
+  // already holds `episodes` entries.
+  TrainingLog(std::filesystem::path file, int save_every, bool append = false, long episodes = 0);
   ~TrainingLog();
   // Records one finished episode of `steps` env steps with its task's score (NaN: none).
-  // Thread-safe.
-  void record(const Info& info, int steps, double score);
+  // Thread-safe. With slots (a vector's envs), env `slot`'s entries wait for commit(), which
+  // writes them in slot order, so the file's line order does not depend on which env thread
+  // finished first.
+  void record(const Info& info, int steps, double score, int slot = -1);
+  // Ordered mode for `slots` envs (called before any record).
+  void set_slots(int slots);
+  // Writes the waiting entries of every slot, in slot order (call from one thread between steps).
+  void commit();
+  // Commits, then hands the lines to the OS. UserError when the write fails.
   void flush();
-  int episodes() const;
+  // Episodes written (committed) so far, counting those a continued log already held.
+  long episodes() const;
   const std::filesystem::path& file() const { return file_; }
 
  private:
@@ -30,7 +40,9 @@ class TrainingLog {
   int save_every_;
   mutable std::mutex mutex_;
   JsonlWriter writer_;
-  int episodes_ = 0;
+  long episodes_ = 0;
+  std::vector<std::vector<nlohmann::json>> pending_;  // per slot, waiting for commit()
+  void write_locked(const nlohmann::json& entry);
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 

@@ -17,6 +17,7 @@
 #include "envs/self_touch.h"
 #include "eval/figures.h"
 #include "eval/frames.h"
+#include "eval/log_check.h"
 #include "eval/video.h"
 
 namespace cradle::eval {
@@ -141,23 +142,22 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   const fs::path dir = config.save_dir;
   EvaluationReport report;
 
-  // Training log score, as the reference prints first.
-  const fs::path log_file = dir / "logs" / "training.jsonl";
-  std::vector<nlohmann::json> log;
-  if (fs::exists(log_file)) {
-    log = read_jsonl(log_file);
-    report.training_episodes = static_cast<int>(log.size());
-    report.training_score = training_score(config.behavior, log);
-    if (config.behavior == Behavior::kHandRegard)
-      report.training_hand_regard = hand_regard_score(log);
-  }
-
   // The training scene when there is one (no re-build), else the config's.
   const fs::path scene_file = dir / scene::kSceneFileName;
   auto assets =
       fs::exists(scene_file) ? envs::make_assets(config, scene_file) : envs::make_assets(config);
   envs::BabyBenchEnv env(assets, options.seed);
   const mjModel* m = env.model();
+  // Training log score, as the reference prints first (entries checked against this model).
+  const fs::path log_file = dir / "logs" / "training.jsonl";
+  std::vector<nlohmann::json> log;
+  if (fs::exists(log_file)) {
+    log = read_training_log(log_file, config.behavior, m->ngeom);
+    report.training_episodes = static_cast<int>(log.size());
+    report.training_score = training_score(config.behavior, log);
+    if (config.behavior == Behavior::kHandRegard)
+      report.training_hand_regard = hand_regard_score(log);
+  }
   const Policy policy = given_policy ? given_policy : random_policy(options.seed ^ 0x5eedULL);
   const auto* hand_regard = dynamic_cast<const envs::HandRegard*>(&env.task());
 

@@ -6,9 +6,15 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/sealed_file.h"
 
 namespace cradle::learn {
 namespace {
+
+// The first line of a library message (LibTorch's run over several).
+std::string first_line(std::string_view text) {
+  return std::string(text.substr(0, text.find('\n')));
+}
 
 std::string read_string(torch::serialize::InputArchive& archive, const std::string& key) {
   c10::IValue value;
@@ -35,15 +41,21 @@ CheckpointInfo read_header(torch::serialize::InputArchive& archive,
           .steps = read_int(archive, "steps")};
 }
 
+// Verifies the sealed file (sizes, checksums) before LibTorch sees a byte of it.
 void load_archive(torch::serialize::InputArchive& archive, const std::filesystem::path& file) {
-  if (!std::filesystem::is_regular_file(file)) {
-    throw UserError(file.string() + ": no such checkpoint file");
+  const Sections sections = read_sealed(file, "checkpoint");
+  const auto payload = sections.find(kCheckpointPayload);
+  if (payload == sections.end()) {
+    throw UserError(file.string() + ": not a Cradle checkpoint (no learner payload)");
   }
   try {
-    archive.load_from(file.string());
+    std::istringstream in(payload->second);
+    archive.load_from(in);
   } catch (const c10::Error& error) {
-    throw UserError(file.string() + ": not a Cradle checkpoint (" + error.what_without_backtrace() +
-                    ")");
+    throw UserError(file.string() + ": not a Cradle checkpoint (" +
+                    first_line(error.what_without_backtrace()) + ")");
+  } catch (const std::exception& error) {
+    throw UserError(file.string() + ": not a Cradle checkpoint (" + first_line(error.what()) + ")");
   }
 }
 
@@ -58,18 +70,15 @@ void write_checkpoint(const std::filesystem::path& file, const CheckpointInfo& h
   archive.write("steps", c10::IValue(static_cast<int64_t>(header.steps)));
   write_body(archive);
 
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-  std::filesystem::path temp = file;
-  temp += ".tmp";
+  // Serialised in memory, then sealed (checksums) and written atomically.
+  std::ostringstream bytes;
   try {
-    archive.save_to(temp.string());
+    archive.save_to(bytes);
   } catch (const c10::Error& error) {
-    throw UserError(temp.string() + ": cannot write checkpoint (" + error.what_without_backtrace() +
-                    ")");
+    throw UserError(file.string() + ": cannot write checkpoint (" +
+                    first_line(error.what_without_backtrace()) + ")");
   }
-  std::error_code ec;
-  std::filesystem::rename(temp, file, ec);
-  if (ec) throw UserError(file.string() + ": cannot write checkpoint (" + ec.message() + ")");
+  write_sealed(file, {{kCheckpointPayload, std::move(bytes).str()}});
 }
 
 CheckpointInfo read_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
@@ -90,7 +99,7 @@ CheckpointInfo read_checkpoint(const std::filesystem::path& file, std::string_vi
     return info;
   } catch (const c10::Error& error) {
     throw UserError(file.string() + ": does not fit this learner (" +
-                    error.what_without_backtrace() + ")");
+                    first_line(error.what_without_backtrace()) + ")");
   }
 }
 
@@ -100,8 +109,8 @@ CheckpointInfo read_checkpoint_info(const std::filesystem::path& file) {
   try {
     return read_header(archive, file);
   } catch (const c10::Error& error) {
-    throw UserError(file.string() + ": not a Cradle checkpoint (" + error.what_without_backtrace() +
-                    ")");
+    throw UserError(file.string() + ": not a Cradle checkpoint (" +
+                    first_line(error.what_without_backtrace()) + ")");
   }
 }
 
@@ -177,10 +186,69 @@ void read_module(torch::serialize::InputArchive& archive, const std::string& key
   stage_module(archive, key, module)();
 }
 
+namespace {
+
+// Optimiser state keyed by (group, parameter) index. LibTorch's own Optimizer::save keys it by
+// each parameter's address, which made identical runs write different checkpoints.
+std::string slot(size_t group, size_t param) {
+  return "group" + std::to_string(group) + "/param" + std::to_string(param);
+}
+
+std::string tensor_key(const torch::Tensor& t) {
+  return c10::guts::to_string(t.unsafeGetTensorImpl());
+}
+
+template <class State, class Options>
+void write_states(torch::serialize::OutputArchive& nested, const torch::optim::Optimizer& opt) {
+  const auto& groups = opt.param_groups();
+  for (size_t g = 0; g < groups.size(); ++g) {
+    torch::serialize::OutputArchive options(nested.compilation_unit());
+    static_cast<const Options&>(groups[g].options()).serialize(options);
+    nested.write("group" + std::to_string(g) + "/options", options);
+    const auto& params = groups[g].params();
+    for (size_t p = 0; p < params.size(); ++p) {
+      const auto it = opt.state().find(tensor_key(params[p]));
+      if (it == opt.state().end()) continue;
+      torch::serialize::OutputArchive state(nested.compilation_unit());
+      static_cast<const State&>(*it->second).serialize(state);
+      nested.write(slot(g, p), state);
+    }
+  }
+}
+
+template <class State, class Options>
+void read_states(torch::serialize::InputArchive& nested, torch::optim::Optimizer& opt) {
+  auto& groups = opt.param_groups();
+  opt.state().clear();
+  for (size_t g = 0; g < groups.size(); ++g) {
+    torch::serialize::InputArchive options;
+    nested.read("group" + std::to_string(g) + "/options", options);
+    static_cast<Options&>(groups[g].options()).serialize(options);
+    const auto& params = groups[g].params();
+    for (size_t p = 0; p < params.size(); ++p) {
+      torch::serialize::InputArchive archive;
+      if (!nested.try_read(slot(g, p), archive)) continue;
+      auto state = std::make_unique<State>();
+      state->serialize(archive);
+      opt.state()[tensor_key(params[p])] = std::move(state);
+    }
+  }
+}
+
+}  // namespace
+
 void write_optimizer(torch::serialize::OutputArchive& archive, const std::string& key,
                      const torch::optim::Optimizer& optimizer) {
   torch::serialize::OutputArchive nested(archive.compilation_unit());
-  optimizer.save(nested);
+  if (dynamic_cast<const torch::optim::Adam*>(&optimizer)) {
+    nested.write("kind", c10::IValue(std::string("adam")));
+    write_states<torch::optim::AdamParamState, torch::optim::AdamOptions>(nested, optimizer);
+  } else if (dynamic_cast<const torch::optim::RMSprop*>(&optimizer)) {
+    nested.write("kind", c10::IValue(std::string("rmsprop")));
+    write_states<torch::optim::RMSpropParamState, torch::optim::RMSpropOptions>(nested, optimizer);
+  } else {
+    optimizer.save(nested);  // other optimisers: LibTorch's format
+  }
   archive.write(key, nested);
 }
 
@@ -188,7 +256,19 @@ void read_optimizer(torch::serialize::InputArchive& archive, const std::string& 
                     torch::optim::Optimizer& optimizer) {
   torch::serialize::InputArchive nested;
   archive.read(key, nested);
-  optimizer.load(nested);
+  c10::IValue kind;
+  if (!nested.try_read("kind", kind)) {
+    optimizer.load(nested);
+    return;
+  }
+  if (kind.toStringRef() == "adam" && dynamic_cast<torch::optim::Adam*>(&optimizer)) {
+    read_states<torch::optim::AdamParamState, torch::optim::AdamOptions>(nested, optimizer);
+  } else if (kind.toStringRef() == "rmsprop" &&
+             dynamic_cast<torch::optim::RMSprop*>(&optimizer)) {
+    read_states<torch::optim::RMSpropParamState, torch::optim::RMSpropOptions>(nested, optimizer);
+  } else {
+    throw UserError(key + ": a " + kind.toStringRef() + " optimiser state, not this learner's");
+  }
 }
 
 void write_generator(torch::serialize::OutputArchive& archive, const std::string& key,

@@ -1,8 +1,9 @@
 // Checkpoint files: one LibTorch archive holding a header (format version, algorithm, config
 // text, step counter) and whatever the learner adds (modules, optimisers, the observation
-// normaliser, random generators) under its own keys. Writes are atomic: the archive goes to
-// "<file>.tmp" in the same folder, which is then renamed over <file>, so a crash never leaves a
-// half-written checkpoint behind.
+// normaliser, random generators) under its own keys, sealed with checksums (core/sealed_file.h):
+// a truncated or altered file is a one-line UserError. Writes are atomic: the file goes to
+// "<file>.tmp" in the same folder, synced and renamed over <file>, so a crash or a full disk never
+// leaves a half-written checkpoint behind (the temp file is removed on a write error).
 #pragma once
 
 #include <torch/torch.h>
@@ -17,6 +18,9 @@
 namespace cradle::learn {
 
 inline constexpr long kCheckpointFormat = 1;
+// The LibTorch archive's section in the sealed checkpoint file (core/sealed_file.h); a trainer
+// may add sections of its own (run state, intrinsic rewards) beside it.
+inline constexpr const char* kCheckpointPayload = "learner";
 
 using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
 // Reads the body; gets the header (e.g. to check the saved config against the learner's).

@@ -3,8 +3,10 @@
 #include <charconv>
 #include <sstream>
 #include <system_error>
+#include <type_traits>
 
 #include "core/error.h"
+#include "learn/hyperparam_ranges.h"
 
 namespace cradle::learn {
 namespace {
@@ -107,6 +109,18 @@ void Hyperparameters::apply(const std::map<std::string, std::string>& overrides)
     }
     const bool ok = std::visit([&](auto* field) { return parse_value(text, field); }, found->field);
     if (!ok) throw UserError("hyperparameter '" + name + "': cannot parse '" + text + "'");
+    // Numbers must lie in their declared range (learn/hyperparam_ranges.h).
+    std::visit(
+        [&](const auto* field) {
+          using T = std::remove_cvref_t<decltype(*field)>;
+          if constexpr (std::is_same_v<T, int> || std::is_same_v<T, long> ||
+                        std::is_same_v<T, double>) {
+            check_hyperparameter_range(name, static_cast<double>(*field));
+          } else if constexpr (std::is_same_v<T, std::vector<int>>) {
+            for (const int v : *field) check_hyperparameter_range(name, v);
+          }
+        },
+        found->field);
   }
 }
 

@@ -92,7 +92,15 @@ class Ppo final : public Learner {
         buffer_(config_.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
         collector_(env, pipeline_, options.reward_hook),
         scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
-        update_threads_(update_threads(options, pipeline_.shape())) {}
+        update_threads_(update_threads(options, pipeline_.shape())) {
+    // A minibatch cannot be larger than the rollout it is drawn from.
+    const long rollout = static_cast<long>(config_.n_steps) * env.num_envs();
+    if (config_.batch_size > rollout) {
+      throw UserError("ppo: batch_size " + std::to_string(config_.batch_size) +
+                      " is larger than the rollout (n_steps x envs = " + std::to_string(rollout) +
+                      ")");
+    }
+  }
 
   std::string_view algorithm() const override { return "ppo"; }
   long steps() const override { return steps_; }

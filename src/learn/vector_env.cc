@@ -1,12 +1,15 @@
 #include "learn/vector_env.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
+#include "core/error.h"
 #include "core/rng.h"
+#include "envs/action_check.h"
 
 namespace cradle::learn {
 namespace {
@@ -78,6 +81,8 @@ void ThreadedVecEnv::reset(std::uint64_t seed) {
   std::fill(terminated_.begin(), terminated_.end(), 0);
   std::fill(truncated_.begin(), truncated_.end(), 0);
   std::fill(ended_.begin(), ended_.end(), 0);
+  if (after_step_) after_step_();
+  if (after_reset_) after_reset_();
 }
 
 void ThreadedVecEnv::step(std::span<const double> actions) {
@@ -86,6 +91,7 @@ void ThreadedVecEnv::step(std::span<const double> actions) {
                                 std::to_string(envs_.size() * action_size_) +
                                 " action values, got " + std::to_string(actions.size()));
   }
+  envs::check_finite_actions(actions, action_size_);
   pool_.parallel_for(num_envs(), [this, actions](int i) {
     // Next-step autoreset: an env that ended last call starts its next episode instead.
     if (ended_[i]) {
@@ -100,6 +106,7 @@ void ThreadedVecEnv::step(std::span<const double> actions) {
     truncated_[i] = r.truncated;
     ended_[i] = r.terminated || r.truncated;
   });
+  if (after_step_) after_step_();
 }
 
 void ThreadedVecEnv::reset_ended() {
@@ -108,6 +115,7 @@ void ThreadedVecEnv::reset_ended() {
     envs_[i]->reset();
     ended_[i] = 0;
   });
+  if (after_step_) after_step_();
 }
 
 int ThreadedVecEnv::key_size(int key_index) const {

@@ -53,6 +53,12 @@ class ThreadedVecEnv final : public VecEnv {
   envs::Env& env(int env) override { return *envs_[env]; }
   const envs::Env& env(int env) const override { return *envs_[env]; }
 
+  // Called on the calling thread after every reset() and step() (e.g. to commit a shared log in
+  // env order).
+  void set_after_step(std::function<void()> fn) { after_step_ = std::move(fn); }
+  // Called after every reset(seed), after the after-step call (e.g. an intrinsic reward's reset).
+  void set_after_reset(std::function<void()> fn) { after_reset_ = std::move(fn); }
+
   // Elements of one observation key per env.
   int key_size(int key_index) const;
   // Batched copy of one observation key: out holds num_envs() * key_size(key) values, env-major.
@@ -71,6 +77,7 @@ class ThreadedVecEnv final : public VecEnv {
   std::vector<double> rewards_;
   std::vector<std::uint8_t> terminated_, truncated_;
   std::vector<std::uint8_t> ended_;  // episode ended in the last call: reset on the next step
+  std::function<void()> after_step_, after_reset_;
 };
 
 }  // namespace cradle::learn

@@ -49,5 +49,7 @@ Config config_from_text(const std::string& text, const std::string& source);
 
 void bind_env(py::module_& m);
 void bind_learn(py::module_& m);
+void bind_tma(py::module_& m);
+void bind_sami(py::module_& m);
 
 }  // namespace cradle::python

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "envs/babybench.h"
 #include "eval/evaluation.h"
+#include "eval/log_check.h"
 #include "eval/scores.h"
 #include "learn/vector_env.h"
 #include "python/common.h"
@@ -450,8 +451,10 @@ void bind_learn(py::module_& m) {
       [](const std::string& behavior, const std::string& entries_json) -> py::object {
         const std::optional<Behavior> b = behavior_from_name(behavior);
         if (!b) throw UserError("unknown behavior '" + behavior + "'");
-        const nlohmann::json j = nlohmann::json::parse(entries_json);
+        const nlohmann::json j = nlohmann::json::parse(entries_json, nullptr, false);
+        if (!j.is_array()) throw UserError("training log: expected a list of entries");
         const std::vector<nlohmann::json> entries(j.begin(), j.end());
+        eval::check_training_entries(entries, *b);
         const std::optional<double> s = eval::training_score(*b, entries);
         return s ? py::cast(*s) : py::none();
       },

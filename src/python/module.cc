@@ -115,6 +115,16 @@ PYBIND11_MODULE(_cradle, m) {
       } else {
         PyErr_SetString(PyExc_ValueError, e.what());
       }
+    } catch (const py::error_already_set&) {
+      throw;  // a Python exception: as it is
+    } catch (const py::builtin_exception&) {
+      throw;  // pybind's own (value_error, ...): its translator
+    } catch (const std::exception& e) {
+      // Anything else: one line, never an empty message.
+      std::string message = e.what();
+      for (char& ch : message) ch = (ch == '\n' || ch == '\r') ? ' ' : ch;
+      if (message.empty()) message = "internal error (no message)";
+      PyErr_SetString(PyExc_RuntimeError, ("cradle: internal error: " + message).c_str());
     }
   });
 
@@ -142,4 +152,6 @@ PYBIND11_MODULE(_cradle, m) {
 
   cradle::python::bind_env(m);
   cradle::python::bind_learn(m);
+  cradle::python::bind_tma(m);
+  cradle::python::bind_sami(m);
 }

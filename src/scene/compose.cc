@@ -9,6 +9,7 @@
 #include "model/mjcf.h"
 #include "model/textures.h"
 #include "scene/world.h"
+#include "sim/mujoco_handlers.h"
 
 namespace cradle::scene {
 namespace {
@@ -145,6 +146,7 @@ ModelPtr compile_scene(const SceneFiles& scene) {
   for (const auto& [name, bytes] : scene.assets) add(name, bytes.data(), bytes.size());
 
   char error[1024] = "";
+  sim::install_mujoco_handlers();
   mjModel* m = mj_loadXML(kSceneFileName, vfs.get(), error, sizeof(error));
   mj_deleteVFS(vfs.get());
   if (!m) throw std::runtime_error(std::string("MuJoCo could not compile the scene: ") + error);
@@ -172,6 +174,7 @@ ModelPtr load_scene(const std::filesystem::path& file) {
     throw UserError("scene file '" + file.string() + "' does not exist");
   }
   char error[1024] = "";
+  sim::install_mujoco_handlers();
   mjModel* m = mj_loadXML(file.c_str(), nullptr, error, sizeof(error));
   if (!m) throw UserError("cannot load scene '" + file.string() + "': " + error);
   return ModelPtr(m);

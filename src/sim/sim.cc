@@ -2,10 +2,17 @@
 
 #include <algorithm>
 
+#include "core/error.h"
+#include "sim/mujoco_handlers.h"
+
 namespace cradle::sim {
 
 Sim::Sim(const mjModel* m, ActuationModel kind, int frame_skip)
-    : m_(m), d_(mj_makeData(m)), actuation_(make_actuation(kind, m)), frame_skip_(frame_skip) {
+    : m_(m),
+      d_((install_mujoco_handlers(), mj_makeData(m))),
+      actuation_(make_actuation(kind, m)),
+      frame_skip_(frame_skip) {
+  if (!d_) throw UserError("MuJoCo: cannot allocate the simulation data (out of memory?)");
   reset();
 }
 

@@ -11,10 +11,12 @@
 #include "core/jsonl.h"
 #include "envs/babybench.h"
 #include "eval/figures.h"
+#include "eval/log_check.h"
 #include "eval/scores.h"
 #include "learn/hyperparams.h"
 #include "learn/intrinsic/reward.h"
 #include "learn/registry.h"
+#include "learn/run_files.h"
 #include "learn/vector_env.h"
 #include "train/babybench_vector.h"
 
@@ -22,12 +24,8 @@ namespace cradle::train {
 namespace {
 
 namespace fs = std::filesystem;
-using learn::CheckpointInfo;
-using learn::Learner;
-using learn::LearnerOptions;
-using learn::TrainStats;
-using learn::VecEnv;
-namespace intrinsic = learn::intrinsic;
+// The run drives a learner: checkpoints, run state, stats and intrinsic rewards are learn's.
+using namespace cradle::learn;
 using Clock = std::chrono::steady_clock;
 
 // Columns of logs/progress.csv, CleanRL's names.
@@ -111,27 +109,42 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     throw UserError("--resume: no checkpoint at '" + latest.string() + "'");
   }
 
-  // A resumed run keeps its algorithm and hyperparameters; the env log and progress continue.
-  std::string algorithm = options.algorithm;
+  // A resumed run keeps its algorithm; --hp values override the checkpoint's (those that fix
+  // network shapes or observation settings are then refused by load()). The logs are cut back to
+  // what the checkpoint knows.
+  std::string algorithm = options.algorithm.empty() ? "ppo" : options.algorithm;
   std::map<std::string, std::string> hyperparameters = options.hyperparameters;
+  RunState resumed;
   if (options.resume) {
-    const CheckpointInfo info = learn::read_checkpoint_info(latest);
+    const CheckpointInfo info = read_checkpoint_info(latest);
+    if (!options.algorithm.empty() && options.algorithm != info.algorithm) {
+      throw UserError("--resume: the checkpoint is " + info.algorithm + ", not --algo " +
+                      options.algorithm + " (leave --algo out to continue it)");
+    }
     algorithm = info.algorithm;
-    hyperparameters = learn::parse_hyperparameter_text(info.config);
+    hyperparameters = parse_hyperparameter_text(info.config);
+    for (const auto& [name, value] : options.hyperparameters) hyperparameters[name] = value;
+    resumed = load_run_state(latest, nullptr);
   }
+  const fs::path log_file = dir / "logs" / "training.jsonl";
+  const long kept_episodes = options.resume ? cut_training_log(log_file, resumed.episodes) : -1;
 
   auto vec = make_babybench_vec_env(config, options.envs, options.threads, /*training=*/true,
-                                    options.seed);
-  if (options.randomize_start) {
-    for (int i = 0; i < vec->num_envs(); ++i)
-      vec->env(i).set_reset_options({{"randomize_start", 1}});
+                                    options.seed, kept_episodes);
+  std::vector<envs::BabyBenchEnv*> envs;
+  for (int i = 0; i < vec->num_envs(); ++i) {
+    if (options.randomize_start) vec->env(i).set_reset_options({{"randomize_start", 1}});
+    // The family's own: a resumed run's first reset ends no episode of this run's log.
+    envs.push_back(&dynamic_cast<envs::BabyBenchEnv&>(vec->env(i)));
+    if (options.resume) envs.back()->skip_next_record();
   }
+  const std::shared_ptr<envs::TrainingLog> training_log = envs[0]->log();
   std::unique_ptr<intrinsic::Composite> reward;
   if (!options.intrinsic.empty()) {
     reward = intrinsic::parse_intrinsic(options.intrinsic);
     reward->bind(*vec);
-    // No reset(): the learner resets the vector itself at the start of learn(), and a freshly
-    // bound reward has no previous observation to pair with the first step.
+    // Every learn() resets the vector: no transition spans that reset.
+    vec->set_after_reset([&reward, &vec] { reward->reset(*vec); });
   }
 
   // Behaviour score of the episodes that end, seen at the step that ends them.
@@ -156,49 +169,44 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   std::unique_ptr<Learner> learner = learn::make_learner(algorithm, *vec, lo);
   if (options.resume) {
     learner->load(latest);
-    if (reward) reward->load(checkpoints);
+    load_run_state(latest, reward.get());
   }
 
   std::error_code ec;
   fs::create_directories(checkpoints, ec);
-  auto save_checkpoint = [&](const fs::path& file) {
-    learner->save(file);
-    if (reward) reward->save(checkpoints);
+  // A checkpoint is an episode boundary: every env's episode is recorded (cut short) and the log
+  // flushed, so the checkpoint's episode count is the log's, and the next learn() starts fresh
+  // episodes exactly as a resumed run does.
+  auto save_checkpoint = [&](const std::vector<fs::path>& files) {
+    for (envs::BabyBenchEnv* env : envs) env->end_episode();
+    training_log->flush();
+    const RunState run{.steps = learner->steps(), .episodes = training_log->episodes()};
+    for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
   };
 
-  // progress.csv: appended on resume when its columns are this version's, new otherwise (an
-  // older file with other columns is kept beside it, renamed).
+  // progress.csv: continued on resume, cut back to the checkpoint's step (later rows and a torn
+  // line kept aside); another version's file is kept beside a new one.
   const fs::path csv_file = dir / "logs" / "progress.csv";
   std::string header;
   for (size_t c = 0; c < std::size(kColumns); ++c)
     header += (c ? "," : "") + std::string(kColumns[c]);
-  bool append = false;
-  if (options.resume && fs::exists(csv_file)) {
-    std::ifstream old(csv_file);
-    std::string first_line;
-    std::getline(old, first_line);
-    append = first_line == header;
-    if (!append) {
-      fs::path kept = dir / "logs" / "progress.before-resume.csv";
-      for (int k = 2; fs::exists(kept); ++k) {
-        kept = dir / "logs" / ("progress.before-resume-" + std::to_string(k) + ".csv");
-      }
-      fs::rename(csv_file, kept, ec);
-      if (ec) throw UserError("cannot rename '" + csv_file.string() + "': " + ec.message());
-      std::cerr << "progress.csv had other columns; kept as " << kept.string() << "\n";
-    }
-  }
-  std::ofstream csv(csv_file, append ? std::ios::app : std::ios::trunc);
+  ProgressCut cut;
+  if (options.resume) cut = cut_progress(csv_file, header, resumed.steps);
+  if (!cut.kept_aside.empty())
+    std::cerr << "progress.csv rows kept aside in " << cut.kept_aside.string() << "\n";
+  std::ofstream csv(csv_file, cut.append ? std::ios::app : std::ios::trunc);
   if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
-  if (!append) csv << header << "\n";
-  std::vector<std::vector<double>> rows;
+  if (!cut.append) csv << header << "\n";
+  std::vector<std::vector<double>> rows = std::move(cut.rows);
+  for (auto& row : rows) row.resize(std::size(kColumns), std::nan(""));
 
   const auto start = Clock::now();
   long next_checkpoint =
       (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
   const long first_step = learner->steps();
   double last_score = std::nan("");
-  learner->learn(options.steps, [&](const TrainStats& s) {
+  auto on_progress = [&](const TrainStats& s) {
+    check_finite_losses(s, latest);
     if (reward) reward->update();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     if (score_count > 0) last_score = score_sum / score_count;
@@ -228,13 +236,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
     csv << "\n";
     csv.flush();
+    if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
 
-    if (s.steps >= next_checkpoint) {
-      save_checkpoint(checkpoints / ("step_" + std::to_string(s.steps) + ".ckpt"));
-      save_checkpoint(latest);
-      next_checkpoint = (s.steps / options.checkpoint_every + 1) * options.checkpoint_every;
-    }
     if (options.progress_bar) {
       const double done = static_cast<double>(s.steps) / options.steps;
       const double rate = (s.steps - first_step) / std::max(elapsed, 1e-9);
@@ -247,22 +251,40 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                    cell(s.episodic_return).c_str(), cell(last_score).c_str());
       std::fflush(stderr);
     }
-    return !(options.stop && options.stop->load());
-  });
+    // Learning stops at each checkpoint (saved below) and continues in a new learn() call.
+    return s.steps < next_checkpoint && !(options.stop && options.stop->load());
+  };
+  // One learn() call per checkpoint interval.
+  while (learner->steps() < options.steps && !(options.stop && options.stop->load())) {
+    const long before = learner->steps();
+    learner->learn(options.steps, on_progress);
+    if (learner->steps() >= next_checkpoint && learner->steps() < options.steps) {
+      save_checkpoint(
+          {checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"), latest});
+      next_checkpoint =
+          (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
+    }
+    if (learner->steps() == before) break;  // a learner that cannot advance
+  }
   if (options.progress_bar) std::fprintf(stderr, "\n");
 
   TrainResult result;
   result.steps = learner->steps();
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.steps_per_second = (result.steps - first_step) / std::max(result.seconds, 1e-9);
-  save_checkpoint(latest);
   result.checkpoint = checkpoints / "final.ckpt";
-  save_checkpoint(result.checkpoint);
-  for (int i = 0; i < vec->num_envs(); ++i) vec->env(i).close();
+  std::vector<fs::path> files = {latest, result.checkpoint};
+  if (learner->steps() >= next_checkpoint) {
+    files.push_back(checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"));
+  }
+  save_checkpoint(files);
+  for (envs::BabyBenchEnv* env : envs) env->close();
   if (!rows.empty()) plot_curves(rows, dir / "plots");
-  const fs::path log = dir / "logs" / "training.jsonl";
-  if (fs::exists(log))
-    result.training_score = eval::training_score(config.behavior, read_jsonl(log));
+  // The score of the whole run's log (a resumed run's earlier episodes included).
+  if (fs::exists(log_file))
+    result.training_score = eval::training_score(
+        config.behavior,
+        eval::read_training_log(log_file, config.behavior, envs[0]->model()->ngeom));
 
   // The trained policy's evaluation, acting deterministically.
   if (options.eval_episodes > 0 && !(options.stop && options.stop->load())) {

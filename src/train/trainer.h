@@ -19,6 +19,7 @@
 namespace cradle::train {
 
 struct TrainOptions {
+  // With resume: empty continues the checkpoint's algorithm, another name is refused.
   std::string algorithm = "ppo";
   std::string intrinsic = "body_part_novelty";  // "name[:weight],..."; empty: env reward only
   long steps = 100000;                          // env steps in total (counting a resumed run)
@@ -28,7 +29,9 @@ struct TrainOptions {
   // one for vector policies.
   int update_threads = 0;
   std::uint64_t seed = 0;
-  bool resume = false;           // continue from <save_dir>/checkpoints/latest.ckpt
+  // Continue from <save_dir>/checkpoints/latest.ckpt: its hyperparameters, with `hyperparameters`
+  // applied over them; the logs are cut back to what the checkpoint knows.
+  bool resume = false;
   bool randomize_start = false;  // random start postures within joint limits
   long checkpoint_every = 100000;
   std::map<std::string, std::string> hyperparameters;  // overrides, by name

@@ -384,7 +384,8 @@ TEST(ConfigErrors, IntegerWrongType) {
 }
 
 TEST(ConfigErrors, IntegerOutOfRange) {
-  EXPECT_EQ(error_of("frame_skip: 0\n"), "config.yml: key 'frame_skip' must be at least 1, got 0");
+  EXPECT_EQ(error_of("frame_skip: 0\n"),
+            "config.yml: key 'frame_skip' must be between 1 and 100, got 0");
   EXPECT_EQ(error_of("max_episode_steps: -5\n"),
             "config.yml: key 'max_episode_steps' must be at least 1, got -5");
   EXPECT_EQ(error_of("save_logs_every: 0\n"),
@@ -520,6 +521,7 @@ TEST(ConfigRoundTrip, EveryFieldChanged) {
 TEST(ConfigRoundTrip, RealsKeepFullPrecisionAndADot) {
   for (double scale : {1.0, 0.1, 1e-7, 3e20, 1.0 / 3.0}) {
     Config c;
+    c.touch_active = false;  // with touch on, scales outside 0.25..100 are refused
     c.touch_scale = scale;
     const std::string yaml = to_yaml(c);
     const size_t at = yaml.find("\ntouch_scale: ");

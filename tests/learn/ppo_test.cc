@@ -177,7 +177,8 @@ TEST(Checkpoint, RejectsWrongAlgorithmShapeAndMissingFiles) {
   const std::filesystem::path file =
       std::filesystem::temp_directory_path() / "cradle_reject_checkpoint.pt";
   auto env = testing::make_cartpoles(1, 30);
-  auto ppo = make_learner("ppo", *env, {.hyperparameters = {{"n_steps", "16"}}});
+  auto ppo =
+      make_learner("ppo", *env, {.hyperparameters = {{"n_steps", "16"}, {"batch_size", "16"}}});
   ppo->save(file);
   auto a2c = make_learner("a2c", *env, {});
   EXPECT_THROW(a2c->load(file), UserError);

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/xml.h"
+#include "envs/action_check.h"
 
 namespace cradle::envs {
 namespace {
@@ -274,6 +275,7 @@ void MimoEnv::simulate(std::span<const double> action) {
 }
 
 StepResult MimoEnv::step(std::span<const double> action) {
+  check_finite_actions(action);
   const Clock::time_point start = Clock::now();
   simulate(process_action(action));
   step_callback();

@@ -1,0 +1,153 @@
+"""TeachMyAgent's two environments (Box2D, stepped in C++), Gymnasium-shaped.
+
+    import numpy as np
+    from cradle import tma
+    env = tma.make("parametric-continuous-parkour-v0", agent_body_type="fish", movable_creepers=True)
+    env.set_environment(input_vector=np.zeros(3), water_level=0.1)   # before reset()
+    obs, info = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    frame = env.render()                                              # (400, 600, 3) uint8
+
+``info["success"]`` is "episode return so far > 230". ``tma.gym.make(...)`` returns the same env
+with the reference's old Gym API (``reset() -> obs``, ``step() -> obs, reward, done, info``), so
+the TeachMyAgent README example runs with ``from cradle.tma import gym``.
+"""
+
+import numbers
+import types
+
+import numpy as np
+
+from . import _cradle
+from . import spaces
+
+STUMP_TRACKS = "parametric-continuous-stump-tracks-v0"
+PARKOUR = "parametric-continuous-parkour-v0"
+ENV_IDS = (STUMP_TRACKS, PARKOUR)
+LIDAR_TYPES = ("down", "up", "full")
+
+
+def embodiments():
+    """Every embodiment name (the seed's ten, then classic_bipedal)."""
+    return list(_cradle.tma_embodiments())
+
+
+def _task_values(name, value):
+    """A task value (number, sequence or numpy array) as a list of floats."""
+    if isinstance(value, (numbers.Real, np.generic)) and np.ndim(value) == 0:
+        return [float(value)]
+    array = np.asarray(value, dtype=np.float64)
+    if array.ndim != 1:
+        raise ValueError(f"task parameter {name} must be a number or a 1-D sequence")
+    return [float(v) for v in array]
+
+
+class TmaEnv:
+    """One TeachMyAgent environment; see the module docstring."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
+
+    def __init__(
+        self,
+        env_id=STUMP_TRACKS,
+        agent_body_type="old_classic_bipedal",
+        movable_creepers=False,
+        lidars_type=None,
+        water_clip=20.0,
+        max_episode_steps=2000,
+        render_mode="rgb_array",
+        **unknown,
+    ):
+        if unknown:
+            raise ValueError(f"unknown TeachMyAgent option '{sorted(unknown)[0]}'")
+        if env_id not in ENV_IDS:
+            raise ValueError(f"unknown env id '{env_id}' (expected one of {', '.join(ENV_IDS)})")
+        if lidars_type is not None and lidars_type not in LIDAR_TYPES:
+            raise ValueError(f"unknown lidars_type '{lidars_type}' (expected down, up or full)")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"unknown render_mode '{render_mode}' (expected 'rgb_array' or None)")
+        self._env = _cradle.TmaEnv(
+            env_id,
+            agent_body_type,
+            lidars_type or "",
+            bool(movable_creepers),
+            float(water_clip),
+            int(max_episode_steps),
+        )
+        self.env_id = env_id
+        self.render_mode = render_mode
+        self.agent_body_type = agent_body_type
+        self.action_space = spaces.make_box(-1.0, 1.0, (self._env.action_size,), np.float32)
+        self.observation_space = spaces.make_box(
+            -np.inf, np.inf, (self._env.observation_size,), np.float64
+        )
+
+    @property
+    def body_type(self):
+        """walker, climber, swimmer or amphibian."""
+        return self._env.body_type
+
+    def set_environment(self, **task):
+        """Sets the task of the next reset(). Stump Tracks: stump_height, obstacle_spacing.
+        Parkour: input_vector (3 values), water_level, creepers_width, creepers_height,
+        creepers_spacing, terrain_cppn_scale. None leaves a parameter at its default."""
+        params = [(k, _task_values(k, v)) for k, v in task.items() if v is not None]
+        self._env.set_environment(params)
+
+    def reset(self, *, seed=None, options=None):
+        if options:
+            self.set_environment(**options)
+        return self._env.reset(seed), {}
+
+    def step(self, action):
+        action = np.asarray(action, dtype=np.float64).ravel()
+        obs, reward, terminated, truncated, success = self._env.step(action)
+        return obs, reward, terminated, truncated, {"success": success}
+
+    def render(self, width=600, height=400, lidars=True):
+        """An RGB frame of the scene (camera on the head)."""
+        return self._env.render(width, height, lidars)
+
+    def terrain(self):
+        """(x, ground, ceiling, water_y) of the current terrain (ceiling empty in Stump Tracks)."""
+        xs, ground, ceiling, water_y = self._env.terrain()
+        return np.asarray(xs), np.asarray(ground), np.asarray(ceiling), water_y
+
+    def head_position(self):
+        return self._env.head_position()
+
+    def close(self):
+        pass
+
+
+def make(env_id, **kwargs):
+    """As the reference's gym.make(env_id, agent_body_type=..., ...): a TmaEnv."""
+    return TmaEnv(env_id, **kwargs)
+
+
+class OldGymEnv:
+    """The reference's Gym API over a TmaEnv: reset() -> obs, step() -> (obs, r, done, info)."""
+
+    def __init__(self, env):
+        self.env = env
+        self.action_space = env.action_space
+        self.observation_space = env.observation_space
+
+    def set_environment(self, **task):
+        self.env.set_environment(**task)
+
+    def reset(self):
+        return self.env.reset()[0]
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        return obs, reward, terminated or truncated, info
+
+    def render(self, mode="rgb_array"):
+        return self.env.render()
+
+    def close(self):
+        self.env.close()
+
+
+gym = types.SimpleNamespace(make=lambda env_id, **kwargs: OldGymEnv(make(env_id, **kwargs)))

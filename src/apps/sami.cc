@@ -1,0 +1,180 @@
+// `cradle sami random|bench|info`: the SaMI environment family (src/sami/). `random` runs random
+// episodes and prints each episode's return and hidden parameters (optionally an mp4 and a PNG of
+// the last frame); `bench` measures env steps/s against the bare mj_steps; `info` prints the
+// spaces and the task sets of every split.
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/rng.h"
+#include "eval/video.h"
+#include "sami/env.h"
+#include "sami/render.h"
+#include "sami/throughput.h"
+
+namespace cradle::apps {
+namespace {
+
+std::string eval_num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+std::string list(const std::vector<double>& values) {
+  std::string out;
+  for (double v : values) out += (out.empty() ? "" : ", ") + eval_num(v);
+  return "{" + out + "}";
+}
+
+std::string cripple_text(const std::vector<int>& joints) {
+  std::string out;
+  for (int j : joints) out += (out.empty() ? "" : ",") + std::to_string(j);
+  return "[" + out + "]";
+}
+
+void random_episodes(const std::string& name, const std::string& split, int episodes,
+                     std::uint64_t seed, const std::string& video, const std::string& png, int size,
+                     int max_steps) {
+  auto env = sami::make_env(name, split, seed);
+  const sami::Spec& spec = env->spec();
+  std::unique_ptr<sami::Renderer> renderer;
+  std::unique_ptr<eval::VideoWriter> writer;
+  std::vector<std::uint8_t> frame;
+  if (!video.empty() || !png.empty()) {
+    renderer = std::make_unique<sami::Renderer>(*env, size, size * 3 / 4);
+    frame.resize(static_cast<size_t>(renderer->width()) * renderer->height() * 3);
+  }
+  if (!video.empty()) {
+    writer = std::make_unique<eval::VideoWriter>(video, renderer->width(), renderer->height(),
+                                                 1.0 / spec.dt);
+  }
+  Rng rng(seed + 1);
+  std::vector<double> action(spec.action_size);
+  for (int e = 0; e < episodes; ++e) {
+    env->reset(e == 0 ? std::optional<std::uint64_t>(seed) : std::nullopt);
+    double ret = 0;
+    sami::StepResult r;
+    do {
+      for (double& a : action) a = rng.uniform(spec.action_low, spec.action_high);
+      r = env->step(action);
+      ret += r.reward;
+      if (writer) {
+        renderer->render(*env, frame);
+        writer->write(frame);
+      }
+    } while (!r.terminated && !r.truncated && (max_steps == 0 || env->info().steps < max_steps));
+    const sami::Info& info = env->info();
+    std::printf("episode %d: return %.3f, %d steps, task set %d", e, ret, info.steps,
+                info.task_set);
+    if (spec.id == sami::EnvId::kPandaPush) {
+      std::printf(", friction %g, cube mass %g, success %d, skill %s\n", info.friction, info.mass,
+                  info.is_success, std::string(sami::skill_name(info.episode_skill)).c_str());
+    } else {
+      std::printf(", mass x%g, damping x%g, crippled %s%s\n", info.mass, info.damping,
+                  cripple_text(info.crippled).c_str(),
+                  info.crippled.empty() || info.masked ? "" : " (geometry only)");
+    }
+  }
+  if (writer) {
+    writer->close();
+    std::printf("video: %s (%d frames)\n", video.c_str(), writer->frames());
+  }
+  if (!png.empty()) {
+    renderer->render(*env, frame);
+    write_png({renderer->width(), renderer->height(), frame}, png);
+    std::printf("frame: %s\n", png.c_str());
+  }
+}
+
+std::vector<sami::EnvId> envs_named(const std::string& name) {
+  if (name == "all") {
+    const auto all = sami::all_envs();
+    return {all.begin(), all.end()};
+  }
+  return {sami::env_from_name(name)};
+}
+
+}  // namespace
+
+void register_sami(CLI::App& app) {
+  struct Options {
+    std::string env = "HalfCheetah";
+    std::string split = "train";
+    int episodes = 3;
+    std::uint64_t seed = 0;
+    std::string video, png;
+    int size = 320;
+    long steps = 20000;
+    int max_steps = 0;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("sami", "SaMI environments (locomotion family, Panda push)");
+  cmd->require_subcommand(1);
+
+  CLI::App* random = cmd->add_subcommand("random", "Random episodes; prints hidden parameters");
+  random->add_option("--env", opts->env, "Env name (see `cradle sami info --env all`)");
+  random->add_option("--split", opts->split, "train, moderate, extreme or a task-set .yml file");
+  random->add_option("--episodes", opts->episodes, "Episodes")->check(CLI::Range(1, 100000));
+  random->add_option("--seed", opts->seed, "Seed of the env and the random policy");
+  random->add_option("--video", opts->video, "Write an mp4 of all episodes");
+  random->add_option("--png", opts->png, "Write a PNG of the last frame");
+  random->add_option("--size", opts->size, "Picture width (height 3/4 of it)")
+      ->check(CLI::Range(16, 2048));
+  random->add_option("--max-steps", opts->max_steps, "End episodes after this many steps (0: none)")
+      ->check(CLI::Range(0, 100000000));
+  random->callback([opts] {
+    random_episodes(opts->env, opts->split, opts->episodes, opts->seed, opts->video, opts->png,
+                    opts->size, opts->max_steps);
+  });
+
+  CLI::App* bench = cmd->add_subcommand("bench", "Env steps/s and ratio to bare mj_step");
+  bench->add_option("--env", opts->env, "Env name or all");
+  bench->add_option("--steps", opts->steps, "Env steps per env")
+      ->check(CLI::Range(100L, 100000000L));
+  bench->callback([opts] {
+    std::printf("%-20s %14s %14s %8s\n", "env", "env steps/s", "bare steps/s", "ratio");
+    for (sami::EnvId id : envs_named(opts->env)) {
+      const sami::Throughput t = sami::measure_throughput(id, opts->steps);
+      std::printf("%-20s %14.0f %14.0f %8.3f\n", std::string(sami::env_name(id)).c_str(),
+                  t.env_steps_per_s, t.bare_steps_per_s, t.ratio);
+    }
+  });
+
+  CLI::App* info = cmd->add_subcommand("info", "Spaces and task sets of an env");
+  info->add_option("--env", opts->env, "Env name or all");
+  info->callback([opts] {
+    for (sami::EnvId id : envs_named(opts->env)) {
+      const sami::Spec s = sami::env_spec(id);
+      std::printf("%s: action %d in [%g, %g], horizon %d, %d x mj_step (dt %g s)\n", s.name.c_str(),
+                  s.action_size, s.action_low, s.action_high, s.horizon, s.frame_skip, s.dt);
+      for (const sami::ObsKey& k : s.keys) {
+        std::printf("  obs %s: %d %s\n", k.name.c_str(), k.size,
+                    std::string(dtype_name(s.obs_dtype)).c_str());
+      }
+      for (sami::Split split :
+           {sami::Split::kTrain, sami::Split::kModerate, sami::Split::kExtreme}) {
+        const auto sets = sami::split_sets(id, split);
+        std::printf("  %s: %zu task sets\n", std::string(sami::split_name(split)).c_str(),
+                    sets.size());
+        for (const sami::TaskSet& t : sets) {
+          if (!t.cells.empty()) {
+            std::printf("    cell friction %g, cube mass %g\n", t.cells[0][0], t.cells[0][1]);
+            continue;
+          }
+          std::string cripple;
+          for (const auto& c : t.cripple) cripple += cripple_text(c);
+          std::printf("    mass %s damping %s%s%s%s\n", list(t.mass).c_str(),
+                      list(t.damping).c_str(), cripple.empty() ? "" : " cripple ", cripple.c_str(),
+                      !cripple.empty() && !t.mask ? " (geometry only)" : "");
+        }
+      }
+    }
+  });
+}
+
+}  // namespace cradle::apps

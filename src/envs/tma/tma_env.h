@@ -1,0 +1,35 @@
+// cradle::envs::Env over a TeachMyAgent environment (src/tma/): one observation entry
+// "observation" (float64, unbounded), actions in [-1, 1]; Info::is_success carries `success`
+// (return > 230) and Info::is_failure a -100 termination.
+#pragma once
+
+#include <memory>
+
+#include "envs/env.h"
+#include "tma/tma_env.h"
+
+namespace cradle::envs {
+
+class TmaEnvAdapter : public Env {
+ public:
+  explicit TmaEnvAdapter(const tma::TmaOptions& options,
+                         std::shared_ptr<const tma::Cppn> cppn = nullptr);
+  const DictSpace& observation_space() const override { return observation_space_; }
+  const Box& action_space() const override { return action_space_; }
+  void reset(std::optional<std::uint64_t> seed = std::nullopt) override;
+  StepResult step(std::span<const double> action) override;
+  const ObservationBuffers& observation() const override { return buffers_; }
+  const Info& info() const override { return info_; }
+  tma::TmaEnv& env() { return env_; }
+
+ private:
+  void copy_observation();
+  tma::TmaEnv env_;
+  DictSpace observation_space_;
+  Box action_space_;
+  ObservationBuffers buffers_;
+  Info info_;
+  int success_slot_ = -1, failure_slot_ = -1;  // info "is_success", "is_failure"
+};
+
+}  // namespace cradle::envs

@@ -1,0 +1,221 @@
+#include "learn/run_files.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <system_error>
+
+#include "core/error.h"
+#include "core/sealed_file.h"
+#include "learn/checkpoint.h"
+#include "learn/intrinsic/reward.h"
+
+namespace cradle::learn {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kRunSection = "run";
+constexpr std::string_view kIntrinsicPrefix = "intrinsic/";
+
+std::string read_all(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw UserError("cannot read " + file.string());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw UserError("cannot read " + file.string());
+  return text;
+}
+
+// Appends text to a file (the aside files collect what was cut, run after run).
+void append_to(const fs::path& file, std::string_view text) {
+  if (text.empty()) return;
+  std::ofstream out(file, std::ios::binary | std::ios::app);
+  out << text;
+  out.flush();
+  if (!out) throw UserError("cannot write " + file.string());
+}
+
+// Complete lines (each with its '\n') and the torn rest (no final newline).
+std::vector<std::string_view> split_lines(std::string_view text, std::string_view& torn) {
+  std::vector<std::string_view> lines;
+  size_t at = 0;
+  for (size_t end; (end = text.find('\n', at)) != std::string_view::npos; at = end + 1) {
+    lines.push_back(text.substr(at, end + 1 - at));
+  }
+  torn = text.substr(at);
+  return lines;
+}
+
+// A staging folder beside `file`, removed when done.
+struct Staging {
+  fs::path dir;
+  explicit Staging(const fs::path& file) : dir(fs::path(file) += ".intrinsic") {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    fs::create_directories(dir, ec);
+    if (ec) throw UserError("cannot create " + dir.string() + ": " + ec.message());
+  }
+  ~Staging() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
+}  // namespace
+
+void save_run_checkpoint(const fs::path& file, const Learner& learner,
+                         const intrinsic::IntrinsicReward* reward, const RunState& run) {
+  // The learner writes its own sealed file first; its sections are then resealed with ours.
+  fs::path part = file;
+  part += ".part";
+  struct Remove {
+    const fs::path& path;
+    ~Remove() {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  } remove_part{part};
+  try {
+    learner.save(part);
+  } catch (const UserError& e) {
+    // Name the checkpoint, not the part file, in the one line.
+    const std::string message = e.what();
+    const size_t at = message.find(": cannot write");
+    throw UserError(file.string() + (at == std::string::npos
+                                         ? ": cannot write checkpoint (" + message + ")"
+                                         : message.substr(at)));
+  }
+  Sections sections = read_sealed(part, "checkpoint");
+  sections[kRunSection] = nlohmann::json{{"steps", run.steps}, {"episodes", run.episodes}}.dump();
+  if (reward) {
+    const Staging staging(file);
+    reward->save(staging.dir);
+    for (const auto& entry : fs::directory_iterator(staging.dir)) {
+      sections[std::string(kIntrinsicPrefix) + entry.path().filename().string()] =
+          read_all(entry.path());
+    }
+  }
+  write_sealed(file, sections);
+}
+
+RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward) {
+  const Sections sections = read_sealed(file, "checkpoint");
+  const auto run = sections.find(kRunSection);
+  if (run == sections.end()) {
+    throw UserError(file.string() + ": a checkpoint without run state (not written by train)");
+  }
+  RunState state;
+  const nlohmann::json j = nlohmann::json::parse(run->second, nullptr, false);
+  if (!j.is_object() || !j.contains("steps") || !j["steps"].is_number_integer() ||
+      !j.contains("episodes") || !j["episodes"].is_number_integer()) {
+    throw UserError(file.string() + ": checkpoint run state is malformed");
+  }
+  state.steps = j["steps"].get<long>();
+  state.episodes = j["episodes"].get<long>();
+  if (reward) {
+    const Staging staging(file);
+    for (const auto& [name, bytes] : sections) {
+      if (!name.starts_with(kIntrinsicPrefix)) continue;
+      const std::string base = name.substr(kIntrinsicPrefix.size());
+      if (base.empty() || base.find('/') != std::string::npos || base.starts_with(".")) {
+        throw UserError(file.string() + ": bad intrinsic section name '" + name + "'");
+      }
+      std::ofstream(staging.dir / base, std::ios::binary) << bytes;
+    }
+    reward->load(staging.dir);
+  }
+  return state;
+}
+
+long cut_training_log(const fs::path& log, long episodes) {
+  std::error_code ec;
+  if (!fs::exists(log, ec)) return 0;
+  const std::string text = read_all(log);
+  std::string_view torn;
+  const std::vector<std::string_view> lines = split_lines(text, torn);
+  // Entries are the non-blank lines; the cut falls after the episodes-th.
+  long kept = 0;
+  size_t cut = 0;
+  for (const std::string_view line : lines) {
+    if (kept == episodes) break;
+    cut += line.size();
+    if (line.find_first_not_of(" \t\r\n") != std::string_view::npos) ++kept;
+  }
+  if (cut == text.size()) return kept;
+  append_to(fs::path(log).replace_filename("training.after-checkpoint.jsonl"),
+            std::string(text.substr(cut)) + (torn.empty() ? "" : "\n"));
+  write_atomically(log, std::string_view(text).substr(0, cut));
+  return kept;
+}
+
+ProgressCut cut_progress(const fs::path& csv, const std::string& header, long step) {
+  ProgressCut result;
+  std::error_code ec;
+  if (!fs::exists(csv, ec)) return result;
+  const std::string text = read_all(csv);
+  std::string_view torn;
+  const std::vector<std::string_view> lines = split_lines(text, torn);
+  const fs::path folder = csv.parent_path();
+
+  // Other columns (another version's file): kept whole beside the new one.
+  if (lines.empty() || lines[0] != header + "\n") {
+    fs::path kept = folder / "progress.before-resume.csv";
+    for (int k = 2; fs::exists(kept); ++k) {
+      kept = folder / ("progress.before-resume-" + std::to_string(k) + ".csv");
+    }
+    fs::rename(csv, kept, ec);
+    if (ec) throw UserError("cannot rename '" + csv.string() + "': " + ec.message());
+    result.kept_aside = kept;
+    return result;
+  }
+
+  // Same columns: rows up to the checkpoint's step stay, the rest goes aside.
+  std::string keep(lines[0]), aside;
+  for (size_t k = 1; k < lines.size(); ++k) {
+    const std::string_view line = lines[k];
+    char* stop = nullptr;
+    const std::string cell(line.substr(0, line.find_first_of(",\n")));
+    const double row_step = std::strtod(cell.c_str(), &stop);
+    if (cell.empty() || *stop != '\0' || !(row_step <= static_cast<double>(step))) {
+      aside += line;
+      continue;
+    }
+    keep += line;
+    std::vector<double>& row = result.rows.emplace_back();
+    size_t at = 0;
+    const std::string body(line.substr(0, line.size() - 1));
+    for (;;) {
+      const size_t comma = body.find(',', at);
+      const std::string value = body.substr(at, comma == std::string::npos ? comma : comma - at);
+      row.push_back(value.empty() ? std::nan("") : std::strtod(value.c_str(), nullptr));
+      if (comma == std::string::npos) break;
+      at = comma + 1;
+    }
+  }
+  if (!torn.empty()) aside += std::string(torn) + "\n";
+  result.append = true;
+  if (aside.empty()) return result;
+  const fs::path aside_file = folder / "progress.after-checkpoint.csv";
+  append_to(aside_file, (fs::exists(aside_file) ? "" : header + "\n") + aside);
+  write_atomically(csv, keep);
+  result.kept_aside = aside_file;
+  return result;
+}
+
+void check_finite_losses(const TrainStats& stats, const fs::path& checkpoint) {
+  for (const auto& [name, value] : stats.losses) {
+    // explained_variance is NaN by definition when the returns do not vary.
+    if (std::isfinite(value) || name == "explained_variance") continue;
+    std::error_code ec;
+    const std::string kept = fs::exists(checkpoint, ec)
+                                 ? "the last good checkpoint is " + checkpoint.string()
+                                 : "no checkpoint was written";
+    throw UserError("the update ending at step " + std::to_string(stats.steps) + " diverged (" +
+                    name + " = " + std::to_string(value) + "); training stopped, " + kept +
+                    " (try a smaller learning_rate or max_grad_norm)");
+  }
+}
+
+}  // namespace cradle::learn

@@ -1,0 +1,54 @@
+// A training run's files across interruptions: the checkpoint the trainer writes (the learner's
+// sealed archive plus the run state and the intrinsic rewards' state, in one atomic file, so they
+// can never pair with another step's), and on resume the logs cut back to what that checkpoint
+// knows (rows and episodes written after it are kept aside, never lost; a torn last line is
+// repaired).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "learn/learner.h"
+
+namespace cradle::learn {
+
+namespace intrinsic {
+class IntrinsicReward;
+}
+
+// What a checkpoint records about the run beyond the learner.
+struct RunState {
+  long steps = 0;     // env steps (the learner's counter)
+  long episodes = 0;  // entries of logs/training.jsonl at the checkpoint (after flushing it)
+};
+
+// Writes `file`: the learner's checkpoint with sections "run" (RunState as JSON) and
+// "intrinsic/<name>" (the files reward->save writes), atomically. A write error (e.g. a full
+// disk) is a one-line UserError; `file` is then left as it was and no temp file remains.
+void save_run_checkpoint(const std::filesystem::path& file, const Learner& learner,
+                         const intrinsic::IntrinsicReward* reward, const RunState& run);
+// The run state of a checkpoint written by save_run_checkpoint; restores `reward` (when given)
+// from it. UserError for a damaged checkpoint or one written without run state.
+RunState load_run_state(const std::filesystem::path& file, intrinsic::IntrinsicReward* reward);
+
+// Cuts logs/training.jsonl back to its first `episodes` entries; later entries and a torn last
+// line are appended to training.after-checkpoint.jsonl beside it. Returns how many entries were
+// kept (fewer than `episodes` only if the log lost some).
+long cut_training_log(const std::filesystem::path& log, long episodes);
+
+// progress.csv on resume. When its header is `header`: rows up to `step` are kept, later rows and
+// a torn last line go to progress.after-checkpoint.csv beside it, and `append` is true. With
+// another header the file is renamed to progress.before-resume[-k].csv and `append` is false.
+struct ProgressCut {
+  bool append = false;
+  std::vector<std::vector<double>> rows;  // the kept rows' values (empty cells NaN)
+  std::filesystem::path kept_aside;       // where cut or renamed rows went (empty: none)
+};
+ProgressCut cut_progress(const std::filesystem::path& csv, const std::string& header, long step);
+
+// Stops training on a non-finite loss (a diverged update): UserError naming the update's step,
+// the loss and the last good checkpoint (`checkpoint`, which the failed update never reached).
+void check_finite_losses(const TrainStats& stats, const std::filesystem::path& checkpoint);
+
+}  // namespace cradle::learn

@@ -1,0 +1,264 @@
+// Interrupted and resumed training end to end: kill -9 after a checkpoint, then --resume, equals
+// an uninterrupted run (logs, progress, final checkpoint); damaged checkpoints, a write error and
+// contradicting flags are one-line errors.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run_shell(const std::string& command) {
+  CliRun r;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
+  r.status = WEXITSTATUS(pclose(pipe));
+  return r;
+}
+
+CliRun cradle(const std::string& args) {
+  return run_shell(std::string(CRADLE_BINARY) + " " + args);
+}
+
+fs::path temp_dir(const std::string& tag) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("cradle_resume_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::vector<std::string> read_lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(line);
+  return rows;
+}
+
+// Lines of the message without the progress bar (its '[###...]' lines and carriage returns).
+std::vector<std::string> message_lines(const std::string& out) {
+  std::vector<std::string> lines;
+  size_t at = 0;
+  for (size_t end; (end = out.find('\n', at)) != std::string::npos; at = end + 1) {
+    std::string line = out.substr(at, end - at);
+    const size_t cr = line.rfind('\r');
+    if (cr != std::string::npos) line = line.substr(cr + 1);
+    if (line.starts_with("[")) continue;  // the progress bar
+    if (!line.empty() && line.find_first_not_of(' ') != std::string::npos) lines.push_back(line);
+  }
+  return lines;
+}
+
+// A quick self-touch training config (no vision, 100-step episodes) writing to dir/run.
+std::string training_config(const fs::path& dir) {
+  const fs::path file = dir / "config.yml";
+  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+                      << "\nvision_active: False\nmax_episode_steps: 100\nsave_logs_every: 1000\n";
+  return file.string();
+}
+
+std::string train_args(const fs::path& dir) {
+  return "train --config " + training_config(dir) +
+         " --envs 2 --threads 2 --intrinsic body_part_novelty --hp n_steps=64 batch_size=64"
+         " n_epochs=1 --eval-episodes 0 --checkpoint-every 256 --no-eval-video --seed 7";
+}
+
+// training.jsonl entries without their wall time (the only field that depends on the clock).
+std::vector<nlohmann::json> log_entries(const fs::path& run) {
+  std::vector<nlohmann::json> entries;
+  for (const std::string& line : read_lines(run / "logs" / "training.jsonl")) {
+    nlohmann::json j = nlohmann::json::parse(line);
+    j.erase("wall_time");
+    entries.push_back(j);
+  }
+  return entries;
+}
+
+// progress.csv's step and loss columns (time, steps/s and perf seconds depend on the clock).
+std::vector<std::string> progress_values(const fs::path& run) {
+  std::vector<std::string> values;
+  for (const std::string& line : read_lines(run / "logs" / "progress.csv")) {
+    std::vector<std::string> cells;
+    size_t at = 0;
+    for (;;) {
+      const size_t comma = line.find(',', at);
+      cells.push_back(line.substr(at, comma == std::string::npos ? comma : comma - at));
+      if (comma == std::string::npos) break;
+      at = comma + 1;
+    }
+    std::string kept;
+    for (size_t c = 0; c + 2 < cells.size(); ++c) {
+      if (c == 1 || c == 2) continue;  // time, charts/SPS
+      kept += cells[c] + ",";
+    }
+    values.push_back(kept);
+  }
+  return values;
+}
+
+// Starts training, kills it with SIGKILL once it has a checkpoint and has gone past it, resumes:
+// the logs continue without loss or duplicates and match an uninterrupted run's, and the final
+// checkpoints are byte-identical.
+TEST(Resume, KillNineThenResumeEqualsUninterruptedRun) {
+  const fs::path killed = temp_dir("killed");
+  const fs::path whole = temp_dir("whole");
+  const std::string cmd = "exec " + std::string(CRADLE_BINARY) + " " + train_args(killed) +
+                          " --steps 100000 >/dev/null 2>&1";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Past the first checkpoint (256) by at least one more rollout, then SIGKILL.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  bool ready = false;
+  while (!ready && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    ready = fs::exists(killed / "run" / "checkpoints" / "latest.ckpt") &&
+            read_lines(killed / "run" / "logs" / "progress.csv").size() >= 4;
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(ready) << "training never passed its first checkpoint";
+  const std::vector<nlohmann::json> before_kill = log_entries(killed / "run");
+
+  CliRun r = cradle(train_args(killed) + " --steps 1024 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = cradle(train_args(whole) + " --steps 1024");
+  ASSERT_EQ(r.status, 0) << r.out;
+
+  // progress.csv: every rollout once, steps strictly increasing, values as uninterrupted.
+  std::vector<long> steps;
+  for (const std::string& line : read_lines(killed / "run" / "logs" / "progress.csv")) {
+    if (line.starts_with("global_step")) continue;
+    steps.push_back(std::stol(line.substr(0, line.find(','))));
+  }
+  const std::vector<long> expected = {128, 256, 384, 512, 640, 768, 896, 1024};
+  EXPECT_EQ(steps, expected);
+  EXPECT_EQ(progress_values(killed / "run"), progress_values(whole / "run"));
+
+  // training.jsonl: the episodes before the checkpoint kept, none twice, as uninterrupted.
+  const std::vector<nlohmann::json> resumed = log_entries(killed / "run");
+  const std::vector<nlohmann::json> uninterrupted = log_entries(whole / "run");
+  ASSERT_GT(resumed.size(), 2u);
+  EXPECT_EQ(resumed, uninterrupted);
+  for (size_t k = 0; k < before_kill.size() && k < resumed.size(); ++k) {
+    // What the killed run wrote up to its checkpoint is the resumed log's start.
+    if (before_kill[k] != resumed[k]) {
+      EXPECT_TRUE(fs::exists(killed / "run" / "logs" / "training.after-checkpoint.jsonl"));
+      break;
+    }
+  }
+  EXPECT_EQ(read_text(killed / "run" / "checkpoints" / "final.ckpt"),
+            read_text(whole / "run" / "checkpoints" / "final.ckpt"));
+  fs::remove_all(killed);
+  fs::remove_all(whole);
+}
+
+// Truncated or altered checkpoints are refused with one line by resume and by evaluate.
+TEST(Resume, DamagedCheckpointsAreOneLineErrors) {
+  const fs::path dir = temp_dir("damaged");
+  CliRun r = cradle(train_args(dir) + " --steps 256");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const fs::path latest = dir / "run" / "checkpoints" / "latest.ckpt";
+  const std::string good = read_text(latest);
+  ASSERT_GT(good.size(), 1000u);
+  const std::vector<std::string> damaged = {good.substr(0, good.size() / 2),
+                                            good.substr(0, 10),
+                                            "",
+                                            good.substr(0, good.size() - 1),
+                                            [&] {
+                                              std::string s = good;
+                                              s[s.size() / 3] ^= 0x10;
+                                              return s;
+                                            }(),
+                                            [&] {
+                                              std::string s = good;
+                                              s[s.size() - 20] ^= 0x01;
+                                              return s;
+                                            }(),
+                                            "PK\x03\x04 not a checkpoint"};
+  for (const std::string& bytes : damaged) {
+    std::ofstream(latest, std::ios::binary | std::ios::trunc) << bytes;
+    r = cradle(train_args(dir) + " --steps 512 --resume");
+    EXPECT_EQ(r.status, 1) << r.out;
+    const std::vector<std::string> lines = message_lines(r.out);
+    ASSERT_EQ(lines.size(), 1u) << r.out;
+    EXPECT_TRUE(lines[0].starts_with("cradle: error: ")) << r.out;
+  }
+  fs::remove_all(dir);
+}
+
+// A write error during a checkpoint (here a file-size limit, as a full disk would): one line,
+// exit 1, the previous checkpoint intact, no temp file, the training log flushed.
+TEST(Resume, CheckpointWriteErrorKeepsPreviousCheckpoint) {
+  const fs::path dir = temp_dir("full");
+  CliRun r = cradle(train_args(dir) + " --steps 256");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const fs::path latest = dir / "run" / "checkpoints" / "latest.ckpt";
+  const std::string before = read_text(latest);
+  const long log_size = static_cast<long>(fs::file_size(dir / "run" / "logs" / "training.jsonl"));
+  // A limit (1 KiB blocks) below the checkpoint's size, above every other file's.
+  const long limit_kib = static_cast<long>(before.size()) / 1024 - 1;
+  ASSERT_GT(limit_kib * 1024, 4 * log_size + 65536) << "checkpoint too small for this test";
+  r = run_shell("trap '' XFSZ; ulimit -f " + std::to_string(limit_kib) + "; exec " + CRADLE_BINARY +
+                " " + train_args(dir) + " --steps 512 --resume");
+  EXPECT_EQ(r.status, 1) << r.out;
+  const std::vector<std::string> lines = message_lines(r.out);
+  ASSERT_EQ(lines.size(), 1u) << r.out;
+  EXPECT_NE(lines[0].find("cannot write"), std::string::npos) << r.out;
+  EXPECT_EQ(read_text(latest), before);
+  for (const auto& entry : fs::directory_iterator(dir / "run" / "checkpoints")) {
+    EXPECT_FALSE(entry.path().string().ends_with(".tmp")) << entry.path();
+    EXPECT_FALSE(entry.path().string().ends_with(".part")) << entry.path();
+  }
+  EXPECT_GT(static_cast<long>(fs::file_size(dir / "run" / "logs" / "training.jsonl")), log_size);
+  // And the run resumes from the intact checkpoint.
+  r = cradle(train_args(dir) + " --steps 512 --resume");
+  EXPECT_EQ(r.status, 0) << r.out;
+  fs::remove_all(dir);
+}
+
+// --resume keeps the checkpoint's algorithm: another --algo is refused; --hp values apply.
+TEST(Resume, ContradictingAlgoIsRefused) {
+  const fs::path dir = temp_dir("algo");
+  CliRun r = cradle(train_args(dir) + " --steps 128");
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = cradle(train_args(dir) + " --steps 256 --resume --algo a2c");
+  EXPECT_EQ(r.status, 1) << r.out;
+  const std::vector<std::string> lines = message_lines(r.out);
+  ASSERT_EQ(lines.size(), 1u) << r.out;
+  EXPECT_NE(lines[0].find("ppo"), std::string::npos) << r.out;
+  r = cradle(train_args(dir) + " --steps 256 --resume --hp learning_rate=0.0001");
+  EXPECT_EQ(r.status, 0) << r.out;
+  const std::vector<std::string> rows = read_lines(dir / "run" / "logs" / "progress.csv");
+  EXPECT_NE(rows.back().find(",0.0001,"), std::string::npos) << rows.back();
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,142 @@
+// Hostile but fair input to the `cradle` binary: every bad flag, seed, hyperparameter, config
+// file and training-log line is one line on stderr and exit 1, quickly.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string out;
+  double seconds = 0;
+};
+
+CliRun cradle(const std::string& args) {
+  const auto start = std::chrono::steady_clock::now();
+  CliRun r;
+  FILE* pipe = popen((std::string(CRADLE_BINARY) + " " + args + " 2>&1 </dev/null").c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
+  r.status = WEXITSTATUS(pclose(pipe));
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+fs::path temp_dir(const std::string& tag) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("cradle_robust_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Lines of output without the progress bar (its '[###...]' lines and carriage returns).
+int message_lines(const std::string& out) {
+  int n = 0;
+  size_t at = 0;
+  for (size_t end; (end = out.find('\n', at)) != std::string::npos; at = end + 1) {
+    std::string line = out.substr(at, end - at);
+    const size_t cr = line.rfind('\r');
+    if (cr != std::string::npos) line = line.substr(cr + 1);
+    if (line.starts_with("[")) continue;  // the progress bar
+    n += line.find_first_not_of(' ') != std::string::npos;
+  }
+  return n;
+}
+
+void expect_one_line_error(const std::string& args) {
+  const CliRun r = cradle(args);
+  EXPECT_EQ(r.status, 1) << args << "\n" << r.out;
+  EXPECT_EQ(message_lines(r.out), 1) << args << "\n" << r.out;
+  EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << "\n" << r.out;
+  EXPECT_LT(r.seconds, 60) << args;
+}
+
+std::string quick_config(const fs::path& dir) {
+  const fs::path file = dir / "config.yml";
+  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+                      << "\nvision_active: False\nmax_episode_steps: 100\n";
+  return file.string();
+}
+
+TEST(Robust, FlagParseErrorsAreOneLineExitOne) {
+  const fs::path dir = temp_dir("flags");
+  const std::string train = "train --config " + quick_config(dir) + " --eval-episodes 0";
+  for (const std::string& args :
+       {train + " --seed -1", train + " --seed 18446744073709551616", train + " --seed 1.5",
+        train + " --seed abc", train + " --envs 0", train + " --steps abc", train + " --no-such",
+        train + " --algo nope", std::string("no-such-command"), std::string(""),
+        std::string("illustrate --envs 100000 --env reach"),
+        "evaluate --config " + quick_config(dir) + " --seed -5"}) {
+    expect_one_line_error(args);
+  }
+  EXPECT_EQ(cradle("--version").status, 0);
+  EXPECT_EQ(cradle("train --help").status, 0);
+  fs::remove_all(dir);
+}
+
+TEST(Robust, BadHyperparametersAreRefusedUpFront) {
+  const fs::path dir = temp_dir("hp");
+  const std::string train = "train --config " + quick_config(dir) +
+                            " --envs 1 --steps 64 --eval-episodes 0 --intrinsic '' --hp n_steps=64";
+  for (const char* hp :
+       {"learning_rate=-1", "learning_rate=nan", "learning_rate=inf", "gamma=2", "clip_range=-1",
+        "max_grad_norm=-1", "vf_coef=-1e9", "ent_coef=inf", "n_epochs=0", "batch_size=0",
+        "gae_lambda=1.5", "pi_layers=64,0", "n_steps=99999999999"}) {
+    expect_one_line_error(train + " " + std::string(hp));
+  }
+  for (const char* algo : {"a2c", "sac", "td3", "ddpg"}) {
+    expect_one_line_error(train + " learning_rate=0 --algo " + algo);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Robust, BadConfigFilesAreOneLineErrors) {
+  const fs::path dir = temp_dir("files");
+  std::ofstream(dir / "big.yml") << std::string(2 << 20, '#');
+  std::ofstream(dir / "noact.yml") << "act_hands: False\nact_fingers: False\nact_arms: False\n"
+                                      "act_feet: False\nact_legs: False\nact_body: False\n"
+                                      "act_head: False\nact_eyes: False\n";
+  std::ofstream(dir / "skip.yml") << "frame_skip: 2147483647\n";
+  std::ofstream(dir / "touch.yml") << "touch_scale: 0.001\n";
+  for (const std::string& file :
+       {std::string("/dev/zero"), std::string("/proc/self/mem"), dir.string(),
+        (dir / "missing.yml").string(), (dir / "big.yml").string(), (dir / "noact.yml").string(),
+        (dir / "skip.yml").string(), (dir / "touch.yml").string()}) {
+    expect_one_line_error("model-info --config " + file);
+  }
+  fs::remove_all(dir);
+}
+
+// Lines of training.jsonl that are JSON but no entry, or name geoms the model lacks.
+TEST(Robust, BadTrainingLogLinesNameTheirLine) {
+  const fs::path dir = temp_dir("log");
+  const std::string config = quick_config(dir);
+  fs::create_directories(dir / "run" / "logs");
+  for (const char* bad :
+       {"42", "null", "[1,2,3]", "\"text\"", R"({"steps":"many"})", R"({"steps":-1})",
+        R"({"steps":10,"right_hand_touches":[100000]})",
+        R"({"steps":10,"right_hand_touches":[-3]})", R"({"steps":10,"left_hand_touches":"x"})"}) {
+    std::ofstream(dir / "run" / "logs" / "training.jsonl")
+        << "{\"steps\":0,\"right_hand_touches\":[],\"left_hand_touches\":[]}\n"
+        << bad << "\n";
+    const CliRun r =
+        cradle("evaluate --config " + config + " --episodes 1 --duration 2 --no-render");
+    EXPECT_EQ(r.status, 1) << bad << "\n" << r.out;
+    EXPECT_EQ(message_lines(r.out), 1) << bad << "\n" << r.out;
+    EXPECT_NE(r.out.find("training.jsonl:2:"), std::string::npos) << bad << "\n" << r.out;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,98 @@
+// Tests for a run's files on resume: the training log and progress.csv cut back to a
+// checkpoint, with what was cut kept aside and torn last lines repaired.
+#include "learn/run_files.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "core/error.h"
+
+namespace cradle::learn {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("cradle_run_files_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream(file, std::ios::binary) << text;
+}
+
+TEST(RunFiles, TrainingLogCutToCheckpointEpisodesKeepsRestAside) {
+  const fs::path dir = fresh_dir("log");
+  const fs::path log = dir / "training.jsonl";
+  write_text(log, "{\"steps\":0}\n{\"steps\":100}\n{\"steps\":100}\n{\"steps\":7}\n{\"ste");
+  EXPECT_EQ(cut_training_log(log, 2), 2);
+  EXPECT_EQ(read_text(log), "{\"steps\":0}\n{\"steps\":100}\n");
+  EXPECT_EQ(read_text(dir / "training.after-checkpoint.jsonl"),
+            "{\"steps\":100}\n{\"steps\":7}\n{\"ste\n");
+  // Nothing past the checkpoint: unchanged; a log shorter than the checkpoint says: all kept.
+  EXPECT_EQ(cut_training_log(log, 2), 2);
+  EXPECT_EQ(cut_training_log(log, 5), 2);
+  EXPECT_EQ(read_text(log), "{\"steps\":0}\n{\"steps\":100}\n");
+  EXPECT_EQ(cut_training_log(log, 0), 0);
+  EXPECT_EQ(read_text(log), "");
+}
+
+TEST(RunFiles, ProgressCutToCheckpointStepRepairsTornLine) {
+  const fs::path dir = fresh_dir("csv");
+  const fs::path csv = dir / "progress.csv";
+  const std::string header = "global_step,time,x";
+  write_text(csv, header + "\n128,1,\n256,2,0.5\n384,3,1\n512,4");
+  ProgressCut cut = cut_progress(csv, header, 256);
+  EXPECT_TRUE(cut.append);
+  EXPECT_EQ(read_text(csv), header + "\n128,1,\n256,2,0.5\n");
+  ASSERT_EQ(cut.rows.size(), 2u);
+  EXPECT_EQ(cut.rows[1][0], 256);
+  EXPECT_EQ(cut.rows[1][2], 0.5);
+  EXPECT_TRUE(std::isnan(cut.rows[0][2]));
+  EXPECT_EQ(read_text(dir / "progress.after-checkpoint.csv"), header + "\n384,3,1\n512,4\n");
+  // A second cut appends to the aside file without a second header.
+  write_text(csv, header + "\n128,1,\n256,2,0.5\n640,5,1\n");
+  cut = cut_progress(csv, header, 256);
+  EXPECT_EQ(read_text(dir / "progress.after-checkpoint.csv"),
+            header + "\n384,3,1\n512,4\n640,5,1\n");
+  // Other columns: the whole file is kept aside, a new one starts.
+  cut = cut_progress(csv, "global_step,other", 256);
+  EXPECT_FALSE(cut.append);
+  EXPECT_FALSE(fs::exists(csv));
+  EXPECT_TRUE(fs::exists(dir / "progress.before-resume.csv"));
+  // No file: a new one.
+  EXPECT_FALSE(cut_progress(csv, header, 256).append);
+}
+
+TEST(RunFiles, NonFiniteLossIsOneLineErrorNamingTheUpdate) {
+  TrainStats stats{.steps = 384};
+  stats.losses = {{"policy_loss", 0.5}, {"explained_variance", std::nan("")}};
+  EXPECT_NO_THROW(check_finite_losses(stats, "/nonexistent/latest.ckpt"));
+  stats.losses["value_loss"] = std::nan("");
+  try {
+    check_finite_losses(stats, "/nonexistent/latest.ckpt");
+    FAIL() << "a NaN loss passed";
+  } catch (const UserError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("step 384"), std::string::npos) << message;
+    EXPECT_NE(message.find("value_loss"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace cradle::learn

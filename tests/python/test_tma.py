@@ -1,0 +1,114 @@
+"""cradle.tma: TeachMyAgent's environments from Python, and the CPPN terrain against numpy."""
+
+import pathlib
+
+import numpy as np
+import pytest
+
+from cradle import tma
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+WEIGHTS = ROOT / "data" / "teachmyagent" / "ground_ceiling_cppn.f32"
+TERRAIN_STEP = 14 / 30
+TERRAIN_HEIGHT = 400 / 30 / 4
+
+
+def numpy_cppn(input_vector):
+    """An independent evaluation of the terrain CPPN (float64) from the weight file."""
+    w = np.fromfile(WEIGHTS, dtype="<f4").astype(np.float64)
+    shapes = [(4, 64), (64, 64), (64, 64), (64, 64), (64, 2)]
+    layers, offset = [], 0
+    for rows, cols in shapes:
+        layers.append(w[offset : offset + rows * cols].reshape(rows, cols))
+        offset += rows * cols
+    assert offset == w.size
+    x = np.arange(200) / 199.0
+    h = np.concatenate([x[:, None], np.tile(np.asarray(input_vector, float), (200, 1))], axis=1)
+    h = np.tanh(h @ layers[0])
+    h = np.logaddexp(0.0, h @ layers[1])
+    h = np.tanh(h @ layers[2])
+    h = np.logaddexp(0.0, h @ layers[3])
+    return h @ layers[4]
+
+
+@pytest.mark.parametrize(
+    "input_vector", [(0.0, 0.0, 0.0), (-0.35, 0.6, -0.1), (0.05, 1.0, 0.3), (-1.0, 1.0, -1.0)]
+)
+def test_cppn_terrain_matches_numpy(input_vector):
+    env = tma.make(tma.PARKOUR, agent_body_type="old_classic_bipedal")
+    env.set_environment(input_vector=np.array(input_vector), water_level=0.0)
+    env.reset(seed=0)
+    xs, ground, ceiling, _ = env.terrain()
+    y = numpy_cppn(input_vector) / 10.0
+    want_ground = y[:, 0] - y[0, 0] + TERRAIN_HEIGHT
+    want_ceiling = np.maximum(y[:, 1] - y[0, 1] + TERRAIN_HEIGHT + 20.0, want_ground)
+    assert len(xs) == 220
+    np.testing.assert_allclose(ground[20:], want_ground, atol=2e-4)
+    np.testing.assert_allclose(ceiling[20:], want_ceiling, atol=2e-4)
+    np.testing.assert_allclose(xs, np.arange(220) * TERRAIN_STEP, atol=1e-9)
+
+
+def test_seed_example_runs_with_the_old_gym_api():
+    from cradle.tma import gym
+
+    env = gym.make("parametric-continuous-parkour-v0", agent_body_type="fish", movable_creepers=True)
+    env.set_environment(input_vector=np.zeros(3), water_level=0.1)
+    env.reset()
+    for _ in range(30):
+        _, _, d, _ = env.step(env.action_space.sample())
+        frame = env.render()
+    assert frame.shape == (400, 600, 3) and frame.dtype == np.uint8
+    assert isinstance(d, bool)
+
+
+@pytest.mark.parametrize(
+    "body, stump, parkour, actions",
+    [
+        ("old_classic_bipedal", 24, 36, 4),
+        ("spider", 42, 54, 12),
+        ("climbing_profile_chimpanzee", 42, 54, 12),
+        ("fish", 26, 38, 4),
+    ],
+)
+def test_spaces(body, stump, parkour, actions):
+    s = tma.make(tma.STUMP_TRACKS, agent_body_type=body)
+    p = tma.make(tma.PARKOUR, agent_body_type=body)
+    assert s.observation_space.shape == (stump,) and p.observation_space.shape == (parkour,)
+    assert s.action_space.shape == (actions,) and p.action_space.shape == (actions,)
+    obs, info = p.reset(seed=0)
+    assert obs.shape == (parkour,) and info == {}
+
+
+def test_gymnasium_shaped_step_and_determinism():
+    runs = []
+    for _ in range(2):
+        env = tma.make(tma.STUMP_TRACKS, agent_body_type="small_bipedal")
+        env.set_environment(stump_height=1.0, obstacle_spacing=3.0)
+        obs, _ = env.reset(seed=11)
+        rng = np.random.default_rng(0)
+        trace = [obs]
+        for _ in range(100):
+            obs, reward, terminated, truncated, info = env.step(rng.uniform(-1, 1, 4))
+            assert set(info) == {"success"} and isinstance(info["success"], bool)
+            trace.append(np.append(obs, reward))
+            if terminated or truncated:
+                break
+        runs.append(np.concatenate(trace))
+    np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def test_bad_inputs_are_value_errors():
+    with pytest.raises(ValueError, match="unknown embodiment 'snake'"):
+        tma.make(tma.STUMP_TRACKS, agent_body_type="snake")
+    with pytest.raises(ValueError, match="unknown env id"):
+        tma.make("parametric-continuous-hexagon-v0")
+    env = tma.make(tma.PARKOUR, agent_body_type="fish")
+    with pytest.raises(ValueError, match="water_level"):
+        env.set_environment(water_level=float("nan"))
+    with pytest.raises(ValueError, match="input_vector takes 3 values"):
+        env.set_environment(input_vector=[0.0, 0.1])
+    with pytest.raises(ValueError, match="unknown Parkour task parameter 'stump_height'"):
+        env.set_environment(stump_height=1.0)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="expected 4"):
+        env.step(np.zeros(5))

@@ -1,0 +1,36 @@
+// The thin adapter to today's envs::Env interface.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "envs/sami/sami_env.h"
+
+namespace cradle::envs {
+namespace {
+
+TEST(SamiAdapter, ForwardsSpacesObservationsAndSuccess) {
+  auto env = make_sami_env("PandaPush", "train", 0);
+  const DictSpace& space = env->observation_space();
+  ASSERT_EQ(space.entries.size(), 3u);
+  EXPECT_EQ(space.entries[0].first, "observation");
+  EXPECT_EQ(space.entries[0].second.dtype, DType::kFloat32);
+  EXPECT_EQ(env->action_space().size(), 4);
+  env->reset(1);
+  auto& adapter = static_cast<SamiEnvAdapter&>(*env);
+  const auto family = adapter.sami().observation();
+  for (int i = 0; i < 19; ++i) EXPECT_FLOAT_EQ(env->observation().f32(0)[i], family[i]);
+  const std::vector<double> action(4, 0.0);
+  const StepResult r = env->step(action);
+  EXPECT_EQ(env->info().steps, 1);
+  EXPECT_EQ(env->info().flag(env->info().find("is_success")), r.terminated);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FLOAT_EQ(env->observation().f32(2)[i], adapter.sami().observation()[22 + i]);
+  }
+
+  auto cheetah = make_sami_env("HalfCheetah", "moderate", 0);
+  cheetah->reset(2);
+  EXPECT_EQ(cheetah->observation().f64(0).size(), 18u);
+}
+
+}  // namespace
+}  // namespace cradle::envs

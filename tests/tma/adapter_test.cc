@@ -1,0 +1,33 @@
+// The cradle::envs::Env adapter: spaces, observation copy and the success / failure flags.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "envs/tma/tma_env.h"
+
+namespace cradle::envs {
+namespace {
+
+TEST(TmaAdapter, SpacesObservationAndFailure) {
+  TmaEnvAdapter env(tma::TmaOptions{.env = tma::EnvId::kStumpTracks, .body = "spider"});
+  ASSERT_EQ(env.observation_space().entries.size(), 1u);
+  EXPECT_EQ(env.observation_space().entries[0].second.size(), 42);
+  EXPECT_EQ(env.action_space().size(), 12);
+  EXPECT_EQ(env.action_space().low[0], -1.0);
+  env.reset(1);
+  const auto obs = env.observation().f64(0);
+  ASSERT_EQ(obs.size(), 42u);
+  EXPECT_EQ(obs[0], env.env().observation()[0]);
+  // Folding every joint drops the spider's body on the ground: a fatal hull contact (-100).
+  std::vector<double> fold(12, -1.0);
+  StepResult r;
+  for (int t = 0; t < 300 && !r.terminated; ++t) r = env.step(fold);
+  EXPECT_TRUE(r.terminated);
+  EXPECT_EQ(r.reward, -100.0);
+  EXPECT_TRUE(env.info().flag(env.info().find("is_failure")));
+  EXPECT_FALSE(env.info().flag(env.info().find("is_success")));
+  EXPECT_EQ(env.observation().f64(0)[1], env.env().observation()[1]);
+}
+
+}  // namespace
+}  // namespace cradle::envs
