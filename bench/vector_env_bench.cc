@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "envs/babybench.h"
 #include "learn/vector_env.h"
+#include "train/babybench_vector.h"
 
 namespace cradle {
 namespace {
@@ -23,7 +24,7 @@ void BM_VecEnvSelfTouch(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(1));
   const Config config =
       load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
-  const auto vec = learn::make_babybench_vec_env(config, n, threads, /*training=*/false, 0);
+  const auto vec = train::make_babybench_vec_env(config, n, threads, /*training=*/false, 0);
   vec->reset(0);
   const Box& space = vec->action_space();
   const size_t dim = space.low.size();
@@ -61,8 +62,8 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
   constexpr int kSteps = 100;  // vector steps per slice (about 40 ms)
   const Config config =
       load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
-  const auto one = learn::make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
-  const auto two = learn::make_babybench_vec_env(config, 2, 2, /*training=*/false, 0);
+  const auto one = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
+  const auto two = train::make_babybench_vec_env(config, 2, 2, /*training=*/false, 0);
   const auto assets = envs::make_assets(config);
   envs::BabyBenchEnv free_a(assets, 1), free_b(assets, 2);
   envs::BabyBenchEnv seq_a(assets, learn::ThreadedVecEnv::env_seed(0, 0));

@@ -8,7 +8,7 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "eval/evaluation.h"
-#include "learn/trainer.h"
+#include "train/trainer.h"
 
 namespace cradle::apps {
 
@@ -54,7 +54,7 @@ void register_evaluate(CLI::App& app) {
                                     .video_extension = "." + opts->format};
     const std::string behavior(behavior_name(config.behavior));
     const eval::Policy policy =
-        opts->policy.empty() ? nullptr : learn::load_policy(config, opts->policy);
+        opts->policy.empty() ? nullptr : train::load_policy(config, opts->policy);
     const eval::EvaluationReport r = eval::evaluate(config, options, policy);
     if (r.training_score) {
       std::printf("training log: %d entries, score %.4f\n", r.training_episodes, *r.training_score);

@@ -22,10 +22,10 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
-#include "eval/plot.h"
+#include "eval/figures.h"
 #include "eval/video.h"
 #include "learn/hyperparams.h"
-#include "learn/learner.h"
+#include "learn/registry.h"
 #include "learn/vector_env.h"
 
 namespace cradle::apps {
@@ -82,22 +82,24 @@ struct Curves {
   std::vector<double> steps, returns, success_rates;
 };
 
-// learning_curve_return.png and learning_curve_success.png in `dir`.
-void plot_curves(const Curves& c, const std::string& title, const fs::path& dir) {
-  auto series = [&](const std::vector<double>& y, const char* label, int color) {
-    return eval::Series{.label = label, .x = c.steps, .y = y, .color = eval::default_color(color)};
+// learning_curve_return.png and learning_curve_success.png in `dir` (matplotlib); true when drawn.
+bool plot_curves(const Curves& c, const std::string& title, const fs::path& dir) {
+  auto series = [&](const std::vector<double>& y, const char* label) {
+    return eval::Series{.label = label, .x = c.steps, .y = y};
   };
-  eval::write_png(eval::render_line_plot({.title = title + ": training return",
-                                          .x_label = "env steps",
-                                          .y_label = "return",
-                                          .series = {series(c.returns, "episodic return", 0)}}),
-                  dir / "learning_curve_return.png");
-  eval::write_png(eval::render_line_plot({.title = title + ": training success rate",
-                                          .x_label = "env steps",
-                                          .y_label = "success rate",
-                                          .series = {series(c.success_rates, "success rate", 1)},
-                                          .y_range = std::pair{0.0, 1.0}}),
-                  dir / "learning_curve_success.png");
+  eval::Figures figures;
+  figures.add(eval::LinePlot{.title = title + ": training return",
+                             .x_label = "env steps",
+                             .y_label = "return",
+                             .series = {series(c.returns, "episodic return")}},
+              dir / "learning_curve_return.png");
+  figures.add(eval::LinePlot{.title = title + ": training success rate",
+                             .x_label = "env steps",
+                             .y_label = "success rate",
+                             .series = {series(c.success_rates, "success rate")},
+                             .y_range = std::pair{0.0, 1.0}},
+              dir / "learning_curve_success.png");
+  return figures.draw(dir / "figures.json");
 }
 
 void run(const IllustrateOptions& o) {
@@ -152,12 +154,13 @@ void run(const IllustrateOptions& o) {
   long successes = 0, ended = 0;  // training episodes, counted by the reward hook
   if (o.train_for > 0 || !o.load_model.empty()) {
     learn::LearnerOptions lo{.seed = o.seed, .hyperparameters = hyperparameters};
-    lo.touch = assets->touch.get();
-    lo.reward_hook = [&](const learn::VecEnv& env, std::span<const double>, std::span<double>) {
+    const int success = vec->info(0).find("is_success");
+    lo.reward_hook = [&, success](const learn::VecEnv& env, std::span<const double>,
+                                  std::span<double>) {
       for (int i = 0; i < env.num_envs(); ++i) {
         if (env.terminated()[i] || env.truncated()[i]) {
           ++ended;
-          successes += env.info(i).is_success;
+          successes += env.info(i).flag(success);
         }
       }
     };
@@ -219,8 +222,7 @@ void run(const IllustrateOptions& o) {
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
-    if (!curves.steps.empty()) {
-      plot_curves(curves, id + " " + o.algorithm, dir);
+    if (!curves.steps.empty() && plot_curves(curves, id + " " + o.algorithm, dir)) {
       std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
     }
   }

@@ -9,8 +9,8 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/rng.h"
-#include "eval/plot.h"
 #include "eval/video.h"
 #include "sami/env.h"
 #include "sami/render.h"
@@ -86,7 +86,7 @@ void random_episodes(const std::string& name, const std::string& split, int epis
   }
   if (!png.empty()) {
     renderer->render(*env, frame);
-    eval::write_png({renderer->width(), renderer->height(), frame}, png);
+    write_png({renderer->width(), renderer->height(), frame}, png);
     std::printf("frame: %s\n", png.c_str());
   }
 }

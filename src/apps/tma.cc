@@ -13,8 +13,8 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "core/rng.h"
-#include "eval/plot.h"
 #include "eval/video.h"
 #include "model/textures.h"
 #include "tma/render.h"
@@ -151,7 +151,7 @@ void register_tma(CLI::App& app) {
     auto snapshot = [&] {
       model::Image image{.width = w, .height = h};
       tma::render(env, w, h, ro->lidars, image.rgb);
-      eval::write_png(image, ro->png);
+      write_png(image, ro->png);
     };
     if (!ro->png.empty() && ro->png_step == 0) snapshot();
     do {

@@ -11,7 +11,7 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "learn/trainer.h"
+#include "train/trainer.h"
 
 namespace cradle::apps {
 namespace {
@@ -26,7 +26,7 @@ void register_train(CLI::App& app) {
   struct Options {
     std::string config;
     std::string save_dir;
-    learn::TrainOptions train;
+    cradle::train::TrainOptions train;
     std::vector<std::string> hp;
     bool no_eval = false;
   };
@@ -78,7 +78,7 @@ void register_train(CLI::App& app) {
     }
     std::signal(SIGINT, on_interrupt);
     opts->train.stop = &interrupted;
-    const learn::TrainResult r = learn::train(config, opts->train);
+    const train::TrainResult r = train::train(config, opts->train);
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
                 r.steps_per_second, interrupted ? " — interrupted" : "");
     std::printf("checkpoint: %s\n", r.checkpoint.c_str());

@@ -1,20 +1,15 @@
-// .npy encoding (format 1.0, header padded to 64 bytes), zip writing (local headers, central
-// directory, end record; methods 0 and 8 via zlib) and the matching reader.
+// .npy encoding (format 1.0, header padded to 64 bytes) and parsing; the zip container around the
+// members is libzip's.
 #include "core/npz.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-#include <zlib.h>
+#include <zip.h>
 
 #include <algorithm>
 #include <bit>
-#include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <limits>
-#include <random>
+#include <memory>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
@@ -30,30 +25,15 @@ static_assert(std::endian::native == std::endian::little, "npz encoding assumes 
 
 using Bytes = std::vector<std::uint8_t>;
 
-constexpr std::uint32_t kLocalSig = 0x04034b50;
-constexpr std::uint32_t kCentralSig = 0x02014b50;
-constexpr std::uint32_t kEndSig = 0x06054b50;
-constexpr std::size_t kLocalSize = 30;    // local file header without name
-constexpr std::size_t kCentralSize = 46;  // central directory header without name
-constexpr std::size_t kEndSize = 22;      // end of central directory record without comment
-constexpr std::uint16_t kVersion = 20;    // zip 2.0: deflate, no zip64
-constexpr std::uint16_t kMadeBy = (3 << 8) | kVersion;       // unix host, so unzip keeps 0644
-constexpr std::uint16_t kUtf8Flag = 0x0800;                  // member names are UTF-8
 constexpr std::uint16_t kDosDate = (0 << 9) | (1 << 5) | 1;  // 1980-01-01, for reproducible files
-constexpr std::uint32_t kUnixMode = 0100644u << 16;
-constexpr std::uint64_t kZipMax = 0xFFFFFFFEu;  // 0xFFFFFFFF itself means "see zip64"
-constexpr std::size_t kMaxMembers = 0xFFFE;
-constexpr std::size_t kMaxDims = 32;  // numpy's NPY_MAXDIMS
+constexpr std::uint32_t kUnixMode = 0100644u << 16;          // so unzip keeps 0644
+constexpr std::size_t kMaxDims = 32;                         // numpy's NPY_MAXDIMS
 constexpr char kMagic[] = "\x93NUMPY";
 
 // Little-endian appends.
 void put16(Bytes& out, std::uint16_t v) {
   out.push_back(static_cast<std::uint8_t>(v));
   out.push_back(static_cast<std::uint8_t>(v >> 8));
-}
-void put32(Bytes& out, std::uint32_t v) {
-  put16(out, static_cast<std::uint16_t>(v));
-  put16(out, static_cast<std::uint16_t>(v >> 16));
 }
 void put_text(Bytes& out, std::string_view s) { out.insert(out.end(), s.begin(), s.end()); }
 
@@ -97,52 +77,6 @@ Bytes npy_header(const std::string& descr, const std::vector<std::size_t>& shape
   return out;
 }
 
-// Raw deflate (no zlib or gzip wrapper), as zip method 8 wants.
-Bytes deflate_raw(const Bytes& in) {
-  z_stream z{};
-  if (deflateInit2(&z, Z_DEFAULT_COMPRESSION, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
-    throw std::runtime_error("npz: zlib deflateInit2 failed");
-  }
-  Bytes out(deflateBound(&z, in.size()));
-  z.next_in = const_cast<Bytef*>(in.data());
-  z.avail_in = static_cast<uInt>(in.size());
-  z.next_out = out.data();
-  z.avail_out = static_cast<uInt>(out.size());
-  int rc = deflate(&z, Z_FINISH);
-  std::size_t written = z.total_out;
-  deflateEnd(&z);
-  if (rc != Z_STREAM_END) throw std::runtime_error("npz: zlib deflate failed");
-  out.resize(written);
-  return out;
-}
-
-// Writes all of `data` to `fd`, retrying short writes; false on error (errno set).
-bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
-  while (size > 0) {
-    ssize_t n = ::write(fd, data, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-// Creates a fresh, exclusive temp file next to `file`; returns its fd (-1 with errno on failure).
-int open_temp(const std::filesystem::path& file, std::filesystem::path& temp) {
-  std::random_device seed;
-  for (int attempt = 0; attempt < 64; ++attempt) {
-    char suffix[16];
-    std::snprintf(suffix, sizeof suffix, ".%08x.tmp", static_cast<unsigned>(seed()));
-    temp = file.parent_path() / ("." + file.filename().string() + suffix);
-    int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0 || errno != EEXIST) return fd;
-  }
-  return -1;
-}
-
 // A malformed input, turned into a UserError naming the file by read_npz.
 struct Malformed : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -174,22 +108,6 @@ struct Cursor {
     return s;
   }
 };
-
-// Inflates raw deflate data that must come out as exactly `size` bytes.
-Bytes inflate_raw(const std::uint8_t* in, std::size_t in_size, std::size_t size) {
-  z_stream z{};
-  if (inflateInit2(&z, -15) != Z_OK) throw std::runtime_error("npz: zlib inflateInit2 failed");
-  Bytes out(size);
-  z.next_in = const_cast<Bytef*>(in);
-  z.avail_in = static_cast<uInt>(in_size);
-  z.next_out = out.data();
-  z.avail_out = static_cast<uInt>(out.size());
-  int rc = inflate(&z, Z_FINISH);
-  std::size_t produced = z.total_out;
-  inflateEnd(&z);
-  if (rc != Z_STREAM_END || produced != size) throw Malformed("corrupt deflate data");
-  return out;
-}
 
 // Position just past ":" of `'key':` in a .npy header dict, skipping spaces.
 std::size_t dict_value(std::string_view dict, std::string_view key) {
@@ -269,61 +187,40 @@ NpyArray parse_npy(const Bytes& npy) {
   return array;
 }
 
-// Reads all members of a zip held in memory.
-std::map<std::string, NpyArray> parse_npz(const Bytes& zip) {
-  if (zip.size() < kEndSize) throw Malformed("not a zip archive");
-  std::size_t end = zip.size() - kEndSize;
-  std::size_t lowest = end > 0xFFFF ? end - 0xFFFF : 0;  // the comment is at most 65535 bytes
-  while (Cursor{zip, end}.u32() != kEndSig) {
-    if (end == lowest) throw Malformed("not a zip archive (no end of central directory)");
-    --end;
-  }
-  Cursor eocd{zip, end + 10};
-  std::size_t entries = eocd.u16();
-  std::uint32_t dir_size = eocd.u32();
-  std::uint32_t dir_offset = eocd.u32();
-  if (entries == 0xFFFF || dir_size == 0xFFFFFFFF || dir_offset == 0xFFFFFFFF) {
-    throw Malformed("zip64 archives are not supported");
-  }
+// The numpy descr of each element type the writer takes.
+template <typename T>
+constexpr const char* descr_of() {
+  if constexpr (std::is_same_v<T, double>) return "<f8";
+  if constexpr (std::is_same_v<T, float>) return "<f4";
+  if constexpr (std::is_same_v<T, std::int32_t>) return "<i4";
+  if constexpr (std::is_same_v<T, std::int64_t>) return "<i8";
+  if constexpr (std::is_same_v<T, std::uint8_t>) return "|u1";
+}
 
+// libzip's message for an archive's last error.
+std::string zip_message(zip_t* zip) { return zip_strerror(zip); }
+
+// Reads every member of an opened archive.
+std::map<std::string, NpyArray> read_members(zip_t* zip) {
   std::map<std::string, NpyArray> arrays;
-  Cursor dir{zip, dir_offset};
-  for (std::size_t i = 0; i < entries; ++i) {
-    if (dir.u32() != kCentralSig) throw Malformed("bad central directory");
-    dir.pos += 4;  // version made by, version needed
-    std::uint16_t flags = dir.u16();
-    std::uint16_t method = dir.u16();
-    dir.pos += 4;  // time, date
-    std::uint32_t crc = dir.u32();
-    std::uint32_t packed = dir.u32();
-    std::uint32_t size = dir.u32();
-    std::size_t name_size = dir.u16();
-    std::size_t extra_size = dir.u16();
-    std::size_t comment_size = dir.u16();
-    dir.pos += 8;  // disk, internal and external attributes
-    std::uint32_t offset = dir.u32();
-    std::string name = dir.text(name_size);
-    dir.pos += extra_size + comment_size;
-    if (packed == 0xFFFFFFFF || size == 0xFFFFFFFF || offset == 0xFFFFFFFF) {
-      throw Malformed("zip64 members are not supported");
-    }
-    if (flags & 1) throw Malformed("member '" + name + "' is encrypted");
-    if (method != 0 && method != 8) {
-      throw Malformed("member '" + name + "' uses unsupported method " + std::to_string(method));
-    }
-
-    Cursor local{zip, offset};
-    if (local.u32() != kLocalSig) throw Malformed("bad local header of '" + name + "'");
-    local.pos = offset + 26;
-    std::size_t skip = local.u16();
-    skip += local.u16();
-    local.pos += skip;
-    local.need(packed);
-    const std::uint8_t* data = zip.data() + local.pos;
-    Bytes npy = method == 8 ? inflate_raw(data, packed, size) : Bytes(data, data + packed);
-    if (npy.size() != size) throw Malformed("member '" + name + "' has the wrong size");
-    if (crc32_z(0, npy.data(), npy.size()) != crc) {
-      throw Malformed("crc mismatch in '" + name + "'");
+  const zip_int64_t entries = zip_get_num_entries(zip, 0);
+  for (zip_int64_t i = 0; i < entries; ++i) {
+    zip_stat_t stat;
+    if (zip_stat_index(zip, i, 0, &stat) != 0) throw Malformed(zip_message(zip));
+    std::string name = stat.name;
+    // libzip checks the crc when a member is read to its end.
+    zip_file_t* member = zip_fopen_index(zip, i, 0);
+    if (!member) throw Malformed("member '" + name + "': " + zip_message(zip));
+    Bytes npy(stat.size);
+    const zip_int64_t got = zip_fread(member, npy.data(), npy.size());
+    std::string error = got < 0 ? zip_file_strerror(member) : "";
+    // One more read reaches the end, where libzip compares the crc.
+    char probe;
+    if (got >= 0 && zip_fread(member, &probe, 1) != 0) error = zip_file_strerror(member);
+    zip_fclose(member);
+    if (!error.empty()) throw Malformed("member '" + name + "': " + error);
+    if (static_cast<zip_uint64_t>(got) != stat.size) {
+      throw Malformed("member '" + name + "' has the wrong size");
     }
 
     constexpr std::string_view kExt = ".npy";
@@ -336,16 +233,6 @@ std::map<std::string, NpyArray> parse_npz(const Bytes& zip) {
     }
   }
   return arrays;
-}
-
-// The numpy descr of each element type the writer takes.
-template <typename T>
-constexpr const char* descr_of() {
-  if constexpr (std::is_same_v<T, double>) return "<f8";
-  if constexpr (std::is_same_v<T, float>) return "<f4";
-  if constexpr (std::is_same_v<T, std::int32_t>) return "<i4";
-  if constexpr (std::is_same_v<T, std::int64_t>) return "<i8";
-  if constexpr (std::is_same_v<T, std::uint8_t>) return "|u1";
 }
 
 }  // namespace
@@ -378,26 +265,10 @@ void NpzWriter::add_raw(const std::string& name, const std::string& descr,
     throw std::invalid_argument("npz: array '" + name + "' has " + std::to_string(count) +
                                 " elements but shape " + shape_tuple(shape));
   }
-
   Bytes npy = npy_header(descr, shape);
-  if (bytes > kZipMax - npy.size()) {
-    throw UserError("npz: array '" + name + "' is 4 GiB or more; zip64 is not supported");
-  }
   const auto* begin = static_cast<const std::uint8_t*>(data);
   if (bytes > 0) npy.insert(npy.end(), begin, begin + bytes);
-
-  Member m{.name = std::move(member),
-           .crc = static_cast<std::uint32_t>(crc32_z(0, npy.data(), npy.size())),
-           .size = npy.size()};
-  if (compress_) {
-    Bytes packed = deflate_raw(npy);
-    if (packed.size() < npy.size()) {
-      m.deflated = true;
-      npy = std::move(packed);
-    }
-  }
-  m.payload = std::move(npy);
-  members_.push_back(std::move(m));
+  members_.push_back({.name = std::move(member), .npy = std::move(npy)});
 }
 
 void NpzWriter::add(const std::string& name, std::span<const double> data,
@@ -427,9 +298,6 @@ void NpzWriter::add(const std::string& name, std::span<const std::uint8_t> data,
 void NpzWriter::add_strings(const std::string& name, const std::vector<std::string>& values) {
   std::size_t width = 1;  // numpy's shortest byte-string dtype is S1
   for (const std::string& v : values) width = std::max(width, v.size());
-  if (!values.empty() && width > kZipMax / values.size()) {
-    throw UserError("npz: array '" + name + "' is 4 GiB or more; zip64 is not supported");
-  }
   Bytes packed(values.size() * width, 0);
   for (std::size_t i = 0; i < values.size(); ++i) {
     std::copy(values[i].begin(), values[i].end(),
@@ -447,88 +315,65 @@ void NpzWriter::close() {
   auto fail = [&](const std::string& why) -> UserError {
     return UserError("cannot write " + file_.string() + ": " + why);
   };
-  if (members.size() > kMaxMembers) throw fail("more than 65534 arrays; zip64 is not supported");
-
   std::filesystem::path folder = file_.parent_path();
   if (!folder.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(folder, ec);
     if (ec) throw fail("cannot create folder " + folder.string() + ": " + ec.message());
   }
-  std::filesystem::path temp;
-  int fd = open_temp(file_, temp);
-  if (fd < 0) throw fail(std::strerror(errno));
 
-  // Everything below removes the temp file before throwing.
-  auto abandon = [&](const std::string& why) -> UserError {
-    if (fd >= 0) ::close(fd);
-    ::unlink(temp.c_str());
-    return fail(why);
-  };
-  Bytes dir;
-  std::uint64_t offset = 0;
+  // libzip writes a temp file beside the target and renames it on zip_close (atomic); it writes
+  // no file for an archive without members, so that one (22 bytes: the end record) is ours.
+  if (members.empty()) {
+    Bytes end = {0x50, 0x4b, 0x05, 0x06};
+    for (int k = 0; k < 9; ++k) put16(end, 0);
+    const std::filesystem::path temp = file_.string() + ".tmp";
+    {
+      std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+      out.write(reinterpret_cast<const char*>(end.data()),
+                static_cast<std::streamsize>(end.size()));
+      if (!out) throw fail("cannot write " + temp.string());
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp, file_, ec);
+    if (ec) {
+      std::filesystem::remove(temp, ec);
+      throw fail("cannot rename the temp file");
+    }
+    return;
+  }
+  int error = 0;
+  zip_t* zip = zip_open(file_.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  if (!zip) {
+    zip_error_t e;
+    zip_error_init_with_code(&e, error);
+    const std::string why = zip_error_strerror(&e);
+    zip_error_fini(&e);
+    throw fail(why);
+  }
+  // Members in add() order with a fixed date, so equal arrays give equal files.
   for (const Member& m : members) {
-    if (offset > kZipMax) throw abandon("archive is 4 GiB or more; zip64 is not supported");
-    std::uint32_t packed = static_cast<std::uint32_t>(m.payload.size());
-    std::uint16_t method = m.deflated ? 8 : 0;
-    std::uint16_t name_size = static_cast<std::uint16_t>(m.name.size());
-    Bytes local;
-    put32(local, kLocalSig);
-    for (std::uint16_t v : {kVersion, kUtf8Flag, method, std::uint16_t{0}, kDosDate}) {
-      put16(local, v);
+    zip_source_t* source = zip_source_buffer(zip, m.npy.data(), m.npy.size(), 0);
+    const zip_int64_t index =
+        source ? zip_file_add(zip, m.name.c_str(), source, ZIP_FL_ENC_UTF_8) : -1;
+    if (index < 0) {
+      if (source) zip_source_free(source);
+      const std::string why = zip_message(zip);
+      zip_discard(zip);
+      throw fail(why);
     }
-    put32(local, m.crc);
-    put32(local, packed);
-    put32(local, static_cast<std::uint32_t>(m.size));
-    put16(local, name_size);
-    put16(local, 0);
-    put_text(local, m.name);
-
-    put32(dir, kCentralSig);
-    for (std::uint16_t v : {kMadeBy, kVersion, kUtf8Flag, method, std::uint16_t{0}, kDosDate}) {
-      put16(dir, v);
+    if (zip_set_file_compression(zip, index, compress_ ? ZIP_CM_DEFLATE : ZIP_CM_STORE, 0) != 0 ||
+        zip_file_set_dostime(zip, index, 0, kDosDate, 0) != 0 ||
+        zip_file_set_external_attributes(zip, index, 0, ZIP_OPSYS_UNIX, kUnixMode) != 0) {
+      const std::string why = zip_message(zip);
+      zip_discard(zip);
+      throw fail(why);
     }
-    put32(dir, m.crc);
-    put32(dir, packed);
-    put32(dir, static_cast<std::uint32_t>(m.size));
-    for (std::uint16_t v :
-         {name_size, std::uint16_t{0}, std::uint16_t{0}, std::uint16_t{0}, std::uint16_t{0}}) {
-      put16(dir, v);  // name length, extra, comment, disk, internal attributes
-    }
-    put32(dir, kUnixMode);
-    put32(dir, static_cast<std::uint32_t>(offset));
-    put_text(dir, m.name);
-
-    if (!write_all(fd, local.data(), local.size()) ||
-        !write_all(fd, m.payload.data(), m.payload.size())) {
-      throw abandon(std::strerror(errno));
-    }
-    offset += local.size() + m.payload.size();
   }
-  if (offset > kZipMax || dir.size() > kZipMax - offset) {
-    throw abandon("archive is 4 GiB or more; zip64 is not supported");
-  }
-  Bytes end;
-  put32(end, kEndSig);
-  std::uint16_t count = static_cast<std::uint16_t>(members.size());
-  for (std::uint16_t v : {std::uint16_t{0}, std::uint16_t{0}, count, count}) put16(end, v);
-  put32(end, static_cast<std::uint32_t>(dir.size()));
-  put32(end, static_cast<std::uint32_t>(offset));
-  put16(end, 0);
-  if (!write_all(fd, dir.data(), dir.size()) || !write_all(fd, end.data(), end.size()) ||
-      ::fsync(fd) != 0) {
-    throw abandon(std::strerror(errno));
-  }
-  int rc = ::close(fd);
-  fd = -1;
-  if (rc != 0) throw abandon(std::strerror(errno));
-  if (::rename(temp.c_str(), file_.c_str()) != 0) throw abandon(std::strerror(errno));
-
-  // Make the rename itself durable; failure here loses nothing already visible.
-  int dir_fd = ::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
+  if (zip_close(zip) != 0) {
+    const std::string why = zip_message(zip);
+    zip_discard(zip);
+    throw fail(why);
   }
 }
 
@@ -576,13 +421,24 @@ std::vector<std::string> NpyArray::strings() const {
 }
 
 std::map<std::string, NpyArray> read_npz(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw UserError("cannot read npz file " + file.string());
-  Bytes zip((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw UserError("cannot read npz file " + file.string());
+  if (!std::filesystem::is_regular_file(file)) {
+    throw UserError("cannot read npz file " + file.string());
+  }
+  int error = 0;
+  zip_t* zip = zip_open(file.c_str(), ZIP_RDONLY | ZIP_CHECKCONS, &error);
+  if (!zip) {
+    zip_error_t e;
+    zip_error_init_with_code(&e, error);
+    const std::string why = zip_error_strerror(&e);
+    zip_error_fini(&e);
+    throw UserError("bad npz file " + file.string() + ": " + why);
+  }
   try {
-    return parse_npz(zip);
+    auto arrays = read_members(zip);
+    zip_discard(zip);
+    return arrays;
   } catch (const Malformed& e) {
+    zip_discard(zip);
     throw UserError("bad npz file " + file.string() + ": " + e.what());
   }
 }

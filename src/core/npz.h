@@ -12,14 +12,12 @@
 
 namespace cradle {
 
-// Collects named arrays and writes them as one .npz on close(). Each add() encodes (and, when
-// compressing, deflates) its array at once, so memory holds the encoded bytes only. The zip is
-// byte-for-byte deterministic: members in add() order, a fixed 1980-01-01 timestamp. No zip64:
-// add() refuses an array of 4 GiB or more, close() an archive that large or of 65535+ members.
+// Collects named arrays and writes them as one .npz on close() (the zip container through libzip,
+// zip64 when large). Each add() encodes its array as .npy bytes at once; close() compresses. The
+// zip is byte-for-byte deterministic: members in add() order, a fixed 1980-01-01 timestamp.
 class NpzWriter {
  public:
-  // compress: deflate members as np.savez_compressed does (a member that would not shrink is
-  // stored instead); false: store all, as np.savez does.
+  // compress: deflate members as np.savez_compressed does; false: store all, as np.savez does.
   explicit NpzWriter(std::filesystem::path file, bool compress = true);
   NpzWriter(const NpzWriter&) = delete;
   NpzWriter& operator=(const NpzWriter&) = delete;
@@ -28,7 +26,7 @@ class NpzWriter {
 
   // Typed arrays in C order; an empty shape is a 0-d array of one element. std::invalid_argument
   // when the shape product differs from data.size(), on more than 32 dimensions, an empty or
-  // repeated name, or a closed writer; UserError for an array of 4 GiB or more.
+  // repeated name, or a closed writer.
   void add(const std::string& name, std::span<const double> data, std::vector<std::size_t> shape);
   void add(const std::string& name, std::span<const float> data, std::vector<std::size_t> shape);
   void add(const std::string& name, std::span<const std::int32_t> data,
@@ -41,18 +39,15 @@ class NpzWriter {
   // As in numpy, trailing NUL bytes of a value do not survive the round trip.
   void add_strings(const std::string& name, const std::vector<std::string>& values);
 
-  // Writes the file atomically: a temp file in the same folder (parents created), fsync, rename.
+  // Writes the file atomically: a temp file in the same folder (parents created), then rename.
   // Throws UserError with a one-line message if it cannot; no partial file is left. The writer
   // is closed afterwards either way; later calls do nothing.
   void close();
 
  private:
   struct Member {
-    std::string name;                   // zip member name, "<array name>.npy"
-    std::uint32_t crc = 0;              // crc32 of the .npy bytes
-    std::uint64_t size = 0;             // .npy byte count
-    bool deflated = false;              // method 8 when true, 0 (stored) otherwise
-    std::vector<std::uint8_t> payload;  // the bytes as they go into the zip
+    std::string name;               // zip member name, "<array name>.npy"
+    std::vector<std::uint8_t> npy;  // the .npy bytes
   };
 
   // Encodes one array (descr like "<f8", raw little-endian bytes) as a member.
@@ -82,7 +77,7 @@ struct NpyArray {
 
 // Reads every member of an .npz (stored or deflated, as numpy writes them) keyed by array name
 // (".npy" stripped). Throws UserError naming the file on anything malformed or unsupported
-// (zip64 archives, Fortran order, structured dtypes, a bad crc).
+// (Fortran order, structured dtypes, a bad crc).
 std::map<std::string, NpyArray> read_npz(const std::filesystem::path& file);
 
 extern template std::vector<double> NpyArray::values<double>() const;

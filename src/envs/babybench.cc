@@ -43,6 +43,14 @@ DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuati
   return space;
 }
 
+ObservationLayout skin_layout(const senses::Touch& touch) {
+  ObservationLayout layout{.values_per_item = touch.values_per_sensor()};
+  const std::span<const int> geoms = touch.sensor_geoms(), bodies = touch.sensor_bodies();
+  layout.groups["geom"].assign(geoms.begin(), geoms.end());
+  layout.groups["body"].assign(bodies.begin(), bodies.end());
+  return layout;
+}
+
 namespace {
 
 // Lays out the skin and settles the pose of a compiled scene.
@@ -55,7 +63,10 @@ std::shared_ptr<const BabyBenchAssets> finish_assets(std::shared_ptr<BabyBenchAs
                                                     config.touch_groups, config.touch_scale),
         .function = config.touch_function,
         .response = config.touch_response};
-    if (!touch.body_scales.empty()) assets->touch = std::make_unique<senses::Touch>(m, touch);
+    if (!touch.body_scales.empty()) {
+      assets->touch = std::make_unique<senses::Touch>(m, touch);
+      assets->touch_layout = skin_layout(*assets->touch);
+    }
   }
 
   // Let the pose settle under zero action (locks already hold from the compiled model on).
@@ -90,6 +101,7 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
       proprio_(assets_->model.get(), proprio_options(assets_->config),
                sim_.actuation().observation_size()),
       task_(make_behaviour(assets_->config, assets_->model.get())),
+      contacts_(assets_->model.get()),
       observation_space_(
           babybench_observation_space(*assets_, sim_.actuation().observation_size())),
       obs_(observation_space_),
@@ -114,6 +126,8 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
     if (!held) free_joints_.push_back(j);
   }
 
+  task_->declare(info_);
+  contacts_.declare(info_);
   sim_.restore(assets_->settled);
   observe();
 }
@@ -126,15 +140,32 @@ BabyBenchEnv::~BabyBenchEnv() {
   }
 }
 
+void BabyBenchEnv::set_reset_options(const ResetOptions& options) {
+  for (const auto& [name, value] : options) {
+    if (name != "randomize_start") {
+      throw UserError("reset option '" + name +
+                      "' is not a BabyBench one (expected randomize_start)");
+    }
+    if (value != 0 && value != 1) {
+      throw UserError("reset option randomize_start must be 0 or 1, not " + std::to_string(value));
+    }
+    randomize_start_ = value != 0;
+  }
+}
+
+const ObservationLayout* BabyBenchEnv::layout(std::string_view key) const {
+  return key == kTouchKey && assets_->touch ? &assets_->touch_layout : nullptr;
+}
+
 void BabyBenchEnv::close() {
-  if (log_ && steps_ > 0 && !skip_record_) log_->record(info_, steps_, log_slot_);
+  if (log_ && steps_ > 0 && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
   skip_record_ = true;
   if (log_) log_->flush();
   log_.reset();
 }
 
 void BabyBenchEnv::end_episode() {
-  if (log_ && !skip_record_) log_->record(info_, steps_, log_slot_);
+  if (log_ && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
   skip_record_ = true;
 }
 
@@ -144,9 +175,8 @@ std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long 
   scene::write_scene(assets.scene, dir);
   std::error_code ec;
   std::filesystem::create_directories(dir / "videos", ec);
-  return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.behavior,
-                                       config.save_logs_every, continue_log >= 0,
-                                       std::max(continue_log, 0L));
+  return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.save_logs_every,
+                                       continue_log >= 0, std::max(continue_log, 0L));
 }
 
 std::unique_ptr<BabyBenchEnv> make_env(const Config& config, bool training, std::uint64_t seed) {
@@ -164,7 +194,7 @@ int BabyBenchEnv::key_index(std::string_view key) const {
 }
 
 void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
-  if (log_ && !skip_record_) log_->record(info_, steps_, log_slot_);
+  if (log_ && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
   skip_record_ = false;
   if (seed) rng_.seed_with(*seed);
   sim_.reset();
@@ -187,8 +217,9 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
     sim_.step(random_action_);
   }
   steps_ = 0;
-  info_ = Info{};
+  info_.clear();
   task_->reset(model(), sim_.data(), info_);
+  contacts_.update(sim_.data(), info_);
   observe();
 }
 
@@ -203,6 +234,7 @@ StepResult BabyBenchEnv::step(std::span<const double> action) {
   info_.steps = steps_;
   StepResult result;
   result.reward = task_->after_step(model(), sim_.data(), info_);
+  contacts_.update(sim_.data(), info_);
   ++steps_;
   result.truncated = steps_ >= assets_->config.max_episode_steps;
   profile_.other += seconds(Clock::now() - task_start);

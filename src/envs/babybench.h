@@ -13,6 +13,7 @@
 #include "core/config.h"
 #include "core/rng.h"
 #include "envs/env.h"
+#include "envs/self_touch.h"
 #include "envs/task.h"
 #include "envs/training_log.h"
 #include "scene/compose.h"
@@ -34,6 +35,7 @@ struct BabyBenchAssets {
   scene::SceneFiles scene;  // what compiled `model`; written as scene.xml in training mode
   scene::ModelPtr model;
   std::unique_ptr<senses::Touch> touch;  // null when touch is off
+  ObservationLayout touch_layout;        // the skin's layout, published as the "touch" key's
   sim::State settled;  // after 100 zero-action physics steps: every episode starts here
 };
 
@@ -48,6 +50,10 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
 // there, for one env or for every env of a vector. continue_log >= 0: continues the log, which
 // holds that many entries (a resumed run).
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log = -1);
+
+// The skin's layout: 1 or 3 values per sensor; groupings "geom" and "body" (the geom and body
+// each sensor sits on; a body's sensors are contiguous).
+ObservationLayout skin_layout(const senses::Touch& touch);
 
 // The observation space a config produces, without building an env (no GL context needed).
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size);
@@ -87,9 +93,13 @@ class BabyBenchEnv final : public Env {
   // The next reset records nothing (a resumed run: the episode before it was never this env's).
   void skip_next_record() { skip_record_ = true; }
   // Random start postures: every reset draws each free MIMo joint (not held by an active joint
-  // equality) uniformly within its range before the random start actions.
+  // equality) uniformly within its range before the random start actions (reset option
+  // "randomize_start" = 1).
   void set_randomize_start(bool on) { randomize_start_ = on; }
-  void close();
+  void set_reset_options(const ResetOptions& options) override;
+  void close() override;
+  double score() const override { return task_->score(info_, steps_); }
+  const ObservationLayout* layout(std::string_view key) const override;
 
   const DictSpace& observation_space() const override { return observation_space_; }
   const Box& action_space() const override { return sim_.actuation().action_space(); }
@@ -123,6 +133,7 @@ class BabyBenchEnv final : public Env {
   std::optional<senses::Vestibular> vestibular_;
   std::unique_ptr<senses::Eyes> eyes_;
   std::unique_ptr<Task> task_;
+  HandContacts contacts_;
   std::shared_ptr<TrainingLog> log_;
   int log_slot_ = -1;
   bool skip_record_ = false;  // the current episode is already recorded (or not this env's)

@@ -1,5 +1,9 @@
 #include "envs/env.h"
 
+#include <limits>
+
+#include "core/error.h"
+
 namespace cradle::envs {
 
 ObservationBuffers::ObservationBuffers(const DictSpace& space) {
@@ -48,21 +52,14 @@ std::span<const std::byte> ObservationBuffers::bytes(int i) const {
   return view<const std::byte>(storage_, offsets_[i], sizes_[i]);
 }
 
-nlohmann::json Info::to_json(Behavior behavior) const {
-  nlohmann::json j;
-  if (behavior == Behavior::kSelfTouch) {
-    j["right_hand_touches"] = right_hand_touches;
-    j["left_hand_touches"] = left_hand_touches;
-  } else if (behavior == Behavior::kHandRegard) {
-    j["right_eye_right_hand"] = hand_regard[0];
-    j["right_eye_left_hand"] = hand_regard[1];
-    j["left_eye_right_hand"] = hand_regard[2];
-    j["left_eye_left_hand"] = hand_regard[3];
-    j["right_eye_either_hand"] = hand_regard_either[0];
-    j["left_eye_either_hand"] = hand_regard_either[1];
+void Env::set_reset_options(const ResetOptions& options) {
+  if (!options.empty()) {
+    throw UserError("reset option '" + options.begin()->first + "' is not one this env takes");
   }
-  j["steps"] = steps;
-  return j;
 }
+
+double Env::score() const { return std::numeric_limits<double>::quiet_NaN(); }
+
+const ObservationLayout* Env::layout(std::string_view) const { return nullptr; }
 
 }  // namespace cradle::envs

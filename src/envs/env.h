@@ -2,17 +2,19 @@
 // observations into preallocated buffers that the caller reads as typed views.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
-#include <nlohmann/json.hpp>
+#include <functional>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/config.h"
 #include "core/spaces.h"
+#include "envs/info.h"
 
 namespace cradle::envs {
 
@@ -36,21 +38,16 @@ class ObservationBuffers {
   std::vector<DType> dtypes_;
 };
 
-// Per-step information. Behaviours fill their own fields; `steps` is always set.
-struct Info {
-  int steps = 0;  // env steps in this episode before this one (0 on the first step)
-  // MIMo sample envs: the task's success and failure flags of the last step.
-  bool is_success = false, is_failure = false;
-  // Self-touch: MIMo geom ids touched by each hand since reset, in order of first contact.
-  std::vector<int> right_hand_touches, left_hand_touches;
-  // Hand regard: steps with each hand in the central field of view of each eye.
-  std::array<int, 4> hand_regard{};  // right_eye_right_hand, right_eye_left_hand,
-                                     // left_eye_right_hand, left_eye_left_hand
-  // Hand regard, Cradle extra: steps with either hand in view of the right / left eye.
-  std::array<int, 2> hand_regard_either{};
-  // The reference's info dict for the behaviour (plus Cradle's extra keys), with `steps`.
-  nlohmann::json to_json(Behavior behavior) const;
+// Structure an observation key publishes: `values_per_item` consecutive values per item (e.g. 3
+// force components per touch sensor) and named groupings of the items (group id per item, e.g.
+// the "geom" and "body" each skin sensor sits on), so learners pool without knowing the sense.
+struct ObservationLayout {
+  int values_per_item = 1;
+  std::map<std::string, std::vector<int>, std::less<>> groups;
 };
+
+// Options an env applies at every later reset (randomized starts, a teacher's task parameters).
+using ResetOptions = std::map<std::string, double, std::less<>>;
 
 struct StepResult {
   double reward = 0;
@@ -68,6 +65,16 @@ class Env {
   virtual StepResult step(std::span<const double> action) = 0;
   virtual const ObservationBuffers& observation() const = 0;
   virtual const Info& info() const = 0;
+
+  // Takes options for the following resets; throws UserError for one the env does not take (this
+  // default takes none).
+  virtual void set_reset_options(const ResetOptions& options);
+  // Ends the run: records what the env logs (the last, partial episode). Idempotent.
+  virtual void close() {}
+  // The task's score of the episode so far (NaN when the task has none).
+  virtual double score() const;
+  // The structure an observation key publishes (nullptr: none).
+  virtual const ObservationLayout* layout(std::string_view key) const;
 };
 
 }  // namespace cradle::envs

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace cradle::envs {
 
@@ -22,9 +23,30 @@ HandRegard::HandRegard(const mjModel* m, double half_angle_deg, bool occlusion)
   }
 }
 
+void HandRegard::declare(Info& info) {
+  const char* eyes[2] = {"right_eye_", "left_eye_"};
+  const char* hands[2] = {"right_hand", "left_hand"};
+  for (int eye = 0; eye < 2; ++eye) {
+    for (int hand = 0; hand < 2; ++hand) {
+      pair_slot_[2 * eye + hand] =
+          info.declare(std::string(eyes[eye]) + hands[hand], InfoType::kInt);
+    }
+  }
+  for (int eye = 0; eye < 2; ++eye) {
+    either_slot_[eye] = info.declare(std::string(eyes[eye]) + "either_hand", InfoType::kInt);
+  }
+}
+
 void HandRegard::reset(const mjModel*, const mjData*, Info& info) {
-  info.hand_regard = {};
-  info.hand_regard_either = {};
+  for (int slot : pair_slot_) info.set(slot, 0);
+  for (int slot : either_slot_) info.set(slot, 0);
+}
+
+double HandRegard::score(const Info& info, int steps) const {
+  if (steps == 0) return 0;
+  double sum = 0;
+  for (int slot : pair_slot_) sum += info.number(slot);
+  return sum / (4.0 * steps);
 }
 
 std::array<double, 3> HandRegard::palm_centre(const mjData* d, int hand) const {
@@ -70,10 +92,10 @@ double HandRegard::after_step(const mjModel* m, const mjData* d, Info& info) {
       const double angle = gaze_angle(d, eye, hand) * std::numbers::pi / 180;
       bool in_view = std::cos(angle) > cos_half_angle_;
       if (in_view && occlusion_) in_view = visible(m, d, eye, hand);
-      info.hand_regard[2 * eye + hand] += in_view;
+      info.add(pair_slot_[2 * eye + hand], in_view);
       either = either || in_view;
     }
-    info.hand_regard_either[eye] += either;
+    info.add(either_slot_[eye], either);
   }
   return 0;
 }

@@ -13,8 +13,14 @@ namespace cradle::envs {
 class HandRegard final : public Task {
  public:
   HandRegard(const mjModel* m, double half_angle_deg, bool occlusion);
+  // Info: steps with each hand in view of each eye ("right_eye_right_hand", "right_eye_left_hand",
+  // "left_eye_right_hand", "left_eye_left_hand") and, Cradle's extra, with either hand in view
+  // ("right_eye_either_hand", "left_eye_either_hand").
+  void declare(Info& info) override;
   void reset(const mjModel* m, const mjData* d, Info& info) override;
   double after_step(const mjModel* m, const mjData* d, Info& info) override;
+  // The mean over the four eye-hand pairs of the fraction of steps in view.
+  double score(const Info& info, int steps) const override;
 
   // Angle (deg) between an eye's optical axis and the direction to a hand's palm centre
   // (eye 0 right, 1 left; hand 0 right, 1 left).
@@ -31,6 +37,8 @@ class HandRegard final : public Task {
   std::array<int, 2> eye_body_{};
   std::array<int, 2> palm_geom_{};  // first geom of right_hand, left_hand (the palm box)
   std::array<int, 2> hand_body_{};
+  std::array<int, 4> pair_slot_{};    // eye-major: right eye (right, left hand), left eye (...)
+  std::array<int, 2> either_slot_{};  // right eye, left eye
 };
 
 }  // namespace cradle::envs

@@ -35,20 +35,30 @@ SelfTouch::SelfTouch(const mjModel* m) : hand_of_geom_(m->ngeom, -1), is_mimo_(m
   }
 }
 
+void SelfTouch::declare(Info& info) {
+  slot_[0] = info.declare("right_hand_touches", InfoType::kIntList);
+  slot_[1] = info.declare("left_hand_touches", InfoType::kIntList);
+}
+
 void SelfTouch::reset(const mjModel* m, const mjData*, Info& info) {
-  for (int h = 0; h < 2; ++h) seen_[h].assign(m->ngeom, 0);
-  // Capacity for every geom, so recording never allocates during an episode.
-  info.right_hand_touches.clear();
-  info.left_hand_touches.clear();
-  info.right_hand_touches.reserve(m->ngeom);
-  info.left_hand_touches.reserve(m->ngeom);
+  for (int h = 0; h < 2; ++h) {
+    seen_[h].assign(m->ngeom, 0);
+    // Capacity for every geom, so recording never allocates during an episode.
+    info.list(slot_[h]).clear();
+    info.list(slot_[h]).reserve(m->ngeom);
+  }
+}
+
+double SelfTouch::score(const Info& info, int) const {
+  return static_cast<double>(info.list(slot_[0]).size() + info.list(slot_[1]).size()) /
+         (2 * kReferenceGeomsPerHand);
 }
 
 void SelfTouch::record(int hand, int other, Info& info) {
   // Only MIMo's own geoms count, never the hand's own (palm and fingers).
   if (!is_mimo_[other] || hand_of_geom_[other] == hand || seen_[hand][other]) return;
   seen_[hand][other] = 1;
-  (hand == 0 ? info.right_hand_touches : info.left_hand_touches).push_back(other);
+  info.list(slot_[hand]).push_back(other);
 }
 
 double SelfTouch::after_step(const mjModel*, const mjData* d, Info& info) {
@@ -60,6 +70,36 @@ double SelfTouch::after_step(const mjModel*, const mjData* d, Info& info) {
     if (hand_of_geom_[g2] >= 0) record(hand_of_geom_[g2], g1, info);
   }
   return 0;
+}
+
+HandContacts::HandContacts(const mjModel* m) : rule_(m) {
+  for (auto& marked : marked_) marked.assign(m->ngeom, 0);
+}
+
+void HandContacts::declare(Info& info) {
+  slot_[0] = info.declare("right_hand_contacts", InfoType::kIntList, /*published=*/false);
+  slot_[1] = info.declare("left_hand_contacts", InfoType::kIntList, /*published=*/false);
+}
+
+void HandContacts::update(const mjData* d, Info& info) {
+  for (int h = 0; h < 2; ++h) {
+    info.list(slot_[h]).clear();
+    info.list(slot_[h]).reserve(marked_[h].size());
+  }
+  auto touch = [&](int hand_geom, int other) {
+    const int hand = rule_.touching_hand(hand_geom, other);
+    if (hand < 0 || marked_[hand][other]) return;
+    marked_[hand][other] = 1;
+    info.list(slot_[hand]).push_back(other);
+  };
+  for (int c = 0; c < d->ncon; ++c) {
+    touch(d->contact[c].geom1, d->contact[c].geom2);
+    touch(d->contact[c].geom2, d->contact[c].geom1);
+  }
+  // The marks only dedupe within this step.
+  for (int h = 0; h < 2; ++h) {
+    for (int g : info.list(slot_[h])) marked_[h][g] = 0;
+  }
 }
 
 std::string geom_label(const mjModel* m, int geom) {

@@ -14,10 +14,14 @@ namespace cradle::envs {
 class Task {
  public:
   virtual ~Task() = default;
+  // Once, when the env is built: the info keys the task writes.
+  virtual void declare(Info& info) { (void)info; }
   // At the start of an episode, after the start state is set.
   virtual void reset(const mjModel* m, const mjData* d, Info& info) = 0;
   // After each env step's physics; returns the reward.
   virtual double after_step(const mjModel* m, const mjData* d, Info& info) = 0;
+  // Score of an episode of `steps` env steps from its info (NaN: the task measures nothing).
+  virtual double score(const Info& info, int steps) const;
 };
 
 // The BabyBench behaviour named by the config ("none" measures nothing).

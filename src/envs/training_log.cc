@@ -2,33 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-
-#include "envs/self_touch.h"
 
 namespace cradle::envs {
 
-double episode_score(Behavior behavior, const Info& info, int steps) {
-  switch (behavior) {
-    case Behavior::kSelfTouch:
-      return static_cast<double>(info.right_hand_touches.size() + info.left_hand_touches.size()) /
-             (2 * SelfTouch::kReferenceGeomsPerHand);
-    case Behavior::kHandRegard: {
-      if (steps == 0) return 0;
-      const int sum =
-          info.hand_regard[0] + info.hand_regard[1] + info.hand_regard[2] + info.hand_regard[3];
-      return static_cast<double>(sum) / (4.0 * steps);
-    }
-    case Behavior::kNone:
-      break;
-  }
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
-TrainingLog::TrainingLog(std::filesystem::path file, Behavior behavior, int save_every, bool append,
-                         long episodes)
+TrainingLog::TrainingLog(std::filesystem::path file, int save_every, bool append, long episodes)
     : file_(std::move(file)),
-      behavior_(behavior),
       save_every_(save_every),
       writer_(file_, append),
       episodes_(append ? episodes : 0) {}
@@ -41,10 +19,9 @@ TrainingLog::~TrainingLog() {
   }
 }
 
-void TrainingLog::record(const Info& info, int steps, int slot) {
-  nlohmann::json entry = info.to_json(behavior_);
+void TrainingLog::record(const Info& info, int steps, double score, int slot) {
+  nlohmann::json entry = info.to_json();
   entry["steps"] = steps;
-  const double score = episode_score(behavior_, info, steps);
   if (!std::isnan(score)) entry["score"] = score;
   std::lock_guard lock(mutex_);
   entry["wall_time"] =

@@ -14,21 +14,17 @@
 
 namespace cradle::envs {
 
-// Score of one episode: self-touch (|right| + |left|) / 68 geoms; hand regard the mean over the
-// four eye-hand pairs of the fraction of steps in view; none: no score (NaN).
-double episode_score(Behavior behavior, const Info& info, int steps);
-
 class TrainingLog {
  public:
   // append = false starts a new log (a new training run); true continues one (resume) that
   // already holds `episodes` entries.
-  TrainingLog(std::filesystem::path file, Behavior behavior, int save_every, bool append = false,
-              long episodes = 0);
+  TrainingLog(std::filesystem::path file, int save_every, bool append = false, long episodes = 0);
   ~TrainingLog();
-  // Records one finished episode of `steps` env steps. Thread-safe. With slots (a vector's envs),
-  // env `slot`'s entries wait for commit(), which writes them in slot order, so the file's line
-  // order does not depend on which env thread finished first.
-  void record(const Info& info, int steps, int slot = -1);
+  // Records one finished episode of `steps` env steps with its task's score (NaN: none).
+  // Thread-safe. With slots (a vector's envs), env `slot`'s entries wait for commit(), which
+  // writes them in slot order, so the file's line order does not depend on which env thread
+  // finished first.
+  void record(const Info& info, int steps, double score, int slot = -1);
   // Ordered mode for `slots` envs (called before any record).
   void set_slots(int slots);
   // Writes the waiting entries of every slot, in slot order (call from one thread between steps).
@@ -41,7 +37,6 @@ class TrainingLog {
 
  private:
   std::filesystem::path file_;
-  Behavior behavior_;
   int save_every_;
   mutable std::mutex mutex_;
   JsonlWriter writer_;

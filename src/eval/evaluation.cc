@@ -15,9 +15,9 @@
 #include "core/rng.h"
 #include "envs/hand_regard.h"
 #include "envs/self_touch.h"
+#include "eval/figures.h"
 #include "eval/frames.h"
 #include "eval/log_check.h"
-#include "eval/plot.h"
 #include "eval/video.h"
 
 namespace cradle::eval {
@@ -36,9 +36,9 @@ struct Trajectory {
 // Score over training episodes from the log (per-episode score, plus the cumulative union for
 // self-touch).
 void plot_training_log(Behavior behavior, const std::vector<nlohmann::json>& entries,
-                       const fs::path& file) {
-  Series per_episode{.label = "episode score", .color = default_color(0), .points = true};
-  Series cumulative{.label = "union of touches so far", .color = default_color(1)};
+                       const fs::path& file, Figures& figures) {
+  Series per_episode{.label = "episode score", .points = true};
+  Series cumulative{.label = "union of touches so far"};
   std::set<int> right, left;
   for (size_t i = 0; i < entries.size(); ++i) {
     const nlohmann::json& e = entries[i];
@@ -58,13 +58,13 @@ void plot_training_log(Behavior behavior, const std::vector<nlohmann::json>& ent
                 .y_label = "score",
                 .series = {per_episode}};
   if (!cumulative.y.empty()) plot.series.push_back(cumulative);
-  write_png(render_line_plot(plot), file);
+  figures.add(plot, file);
 }
 
 // Self-touch coverage per body part: fraction of each MIMo body's geoms touched by each hand over
 // the evaluation episodes.
 void plot_coverage(const mjModel* m, const std::vector<EpisodeResult>& episodes,
-                   const fs::path& file) {
+                   const fs::path& file, Figures& figures) {
   BarChart chart{.title = "Self-touch coverage per body part (evaluation)",
                  .y_label = "fraction of geoms touched",
                  .group_labels = {"right hand", "left hand"},
@@ -93,11 +93,12 @@ void plot_coverage(const mjModel* m, const std::vector<EpisodeResult>& episodes,
       chart.values[hand].push_back(static_cast<double>(hit) / count);
     }
   }
-  write_png(render_bar_chart(chart, 1200, 600), file);
+  figures.add(chart, file, 1200, 600);
 }
 
 // Gaze-hand angle over one episode for the four eye-hand pairs, with the threshold.
-void plot_gaze(const std::vector<double>& angles, double half_angle, const fs::path& file) {
+void plot_gaze(const std::vector<double>& angles, double half_angle, const fs::path& file,
+               Figures& figures) {
   const char* labels[4] = {"right eye - right hand", "right eye - left hand",
                            "left eye - right hand", "left eye - left hand"};
   LinePlot plot{.title = "Gaze-hand angle (evaluation episode 0)",
@@ -106,11 +107,11 @@ void plot_gaze(const std::vector<double>& angles, double half_angle, const fs::p
                 .y_range = std::make_pair(0.0, 180.0),
                 .h_lines = {{half_angle, "central field of view"}}};
   for (int k = 0; k < 4; ++k) {
-    Series s{.label = labels[k], .color = default_color(k)};
+    Series s{.label = labels[k]};
     for (size_t t = 0; 4 * t + k < angles.size(); ++t) s.y.push_back(angles[4 * t + k]);
     plot.series.push_back(std::move(s));
   }
-  write_png(render_line_plot(plot), file);
+  figures.add(plot, file);
 }
 
 void write_trajectory(const Trajectory& traj, int steps, int nq, int nu, const fs::path& file) {
@@ -188,7 +189,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
       env.step(action);
       traj.qpos.insert(traj.qpos.end(), env.data()->qpos, env.data()->qpos + m->nq);
       traj.actions.insert(traj.actions.end(), action.begin(), action.end());
-      traj.infos.push_back(env.info().to_json(config.behavior).dump());
+      traj.infos.push_back(env.info().to_json().dump());
       if (hand_regard) {
         for (int eye = 0; eye < 2; ++eye) {
           for (int hand = 0; hand < 2; ++hand) {
@@ -208,11 +209,16 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
 
     EpisodeResult result;
     result.steps = options.duration;
-    result.score = envs::episode_score(config.behavior, env.info(), options.duration);
-    result.right_hand_touches = env.info().right_hand_touches;
-    result.left_hand_touches = env.info().left_hand_touches;
+    result.score = env.score();
+    const envs::Info& info = env.info();
+    if (const int k = info.find("right_hand_touches"); k >= 0) {
+      result.right_hand_touches.assign(info.list(k).begin(), info.list(k).end());
+    }
+    if (const int k = info.find("left_hand_touches"); k >= 0) {
+      result.left_hand_touches.assign(info.list(k).begin(), info.list(k).end());
+    }
     if (hand_regard) {
-      nlohmann::json entry = env.info().to_json(config.behavior);
+      nlohmann::json entry = info.to_json();
       entry["steps"] = options.duration;
       result.hand_regard = hand_regard_episode_score(entry);
     }
@@ -232,14 +238,17 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
     sq += (e.score - report.mean) * (e.score - report.mean);
   report.std = std::sqrt(sq / options.episodes);
 
-  // Plots.
-  if (!log.empty()) plot_training_log(config.behavior, log, dir / "plots" / "training_score.png");
+  // Plots (matplotlib, from plots/figures.json).
+  Figures figures;
+  const fs::path plots = dir / "plots";
+  if (!log.empty()) plot_training_log(config.behavior, log, plots / "training_score.png", figures);
   if (config.behavior == Behavior::kSelfTouch) {
-    plot_coverage(m, report.episodes, dir / "plots" / "touch_coverage.png");
+    plot_coverage(m, report.episodes, plots / "touch_coverage.png", figures);
   }
   if (hand_regard) {
-    plot_gaze(first_gaze, config.hand_regard_half_angle, dir / "plots" / "gaze_hand_angle.png");
+    plot_gaze(first_gaze, config.hand_regard_half_angle, plots / "gaze_hand_angle.png", figures);
   }
+  if (!figures.empty()) figures.draw(plots / "figures.json");
 
   // evaluation.json: every score, the config, the seed and versions.
   nlohmann::json out = report.to_json();

@@ -67,7 +67,7 @@ class A2c final : public Learner {
         config_(settings_.a2c),
         env_(env),
         generator_(at::make_generator<at::CPUGeneratorImpl>(options.seed)),
-        pipeline_(env.observation_space(), settings_.observation, find_touch(env, options.touch)),
+        pipeline_(env.observation_space(), settings_.observation, find_touch(env)),
         policy_(pipeline_.shape(), env.action_space().size(), settings_.policy, generator_),
         parameters_(*policy_),
         optimizer_(std::vector<torch::Tensor>{parameters_.tensor()},

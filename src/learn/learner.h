@@ -21,10 +21,6 @@
 #include "envs/env.h"
 #include "learn/vec_env.h"
 
-namespace cradle::senses {
-class Touch;
-}
-
 namespace cradle::learn {
 
 // Progress, reported after every rollout and its update (off-policy: every report_every steps).
@@ -65,9 +61,6 @@ struct LearnerOptions {
   // ortho_init, log_std_init; OffPolicyNetworkConfig for SAC, TD3 and DDPG: pi_layers,
   // qf_layers, activation, cnn_features).
   std::map<std::string, std::string> hyperparameters;
-  // The skin the "touch" observation comes from, for touch pooling. When null and env(0) of the
-  // VecEnv is a BabyBenchEnv, its skin is used.
-  const senses::Touch* touch = nullptr;
   RewardHook reward_hook;      // optional
   std::string device = "cpu";  // only "cpu" for now
   // LibTorch intra-op threads (a process-wide setting); 0 leaves it as it is. One thread is the
@@ -106,11 +99,6 @@ class Learner {
   // Every hyperparameter as "name = value" lines (what checkpoints store).
   virtual std::string config_text() const = 0;
 };
-
-// Builds a learner by name ("ppo", "a2c", "sac", "td3", "ddpg"). Throws UserError for an unknown
-// algorithm or hyperparameter, a bad value, or an env the learner cannot handle.
-std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
-                                      const LearnerOptions& options);
 
 // What a checkpoint says about itself, read without building a learner (e.g. to pick the
 // algorithm and hyperparameters for --resume: parse_hyperparameter_text(info.config)).

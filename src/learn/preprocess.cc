@@ -6,11 +6,15 @@
 #include <map>
 
 #include "core/error.h"
-#include "envs/babybench.h"
 #include "learn/vec_env.h"
-#include "senses/touch.h"
 
 namespace cradle::learn {
+namespace {
+
+// The observation key whose layout touch pooling reads.
+constexpr const char* kTouchKey = "touch";
+
+}  // namespace
 
 void ObservationConfig::bind(Hyperparameters& table) {
   table.add("normalize_observations", &normalize_observations,
@@ -42,15 +46,15 @@ void ObservationConfig::check_matches(const std::string& checkpoint_config) cons
 // ---------------------------------------------------------------------------------------------
 // Touch pooling
 
-const senses::Touch* find_touch(const VecEnv& env, const senses::Touch* given) {
-  if (given != nullptr || env.num_envs() == 0) return given;
-  const auto* babybench = dynamic_cast<const envs::BabyBenchEnv*>(&env.env(0));
-  return babybench != nullptr ? babybench->touch() : nullptr;
+const envs::ObservationLayout* find_touch(const VecEnv& env) {
+  return env.num_envs() > 0 ? env.env(0).layout(kTouchKey) : nullptr;
 }
 
-TouchPooling::TouchPooling(const senses::Touch& touch)
-    : values_per_sensor_(touch.values_per_sensor()) {
-  const std::span<const int> sensor_geoms = touch.sensor_geoms();
+TouchPooling::TouchPooling(const envs::ObservationLayout& skin)
+    : values_per_sensor_(skin.values_per_item) {
+  const auto it = skin.groups.find("geom");
+  if (it == skin.groups.end()) throw UserError("touch pooling needs the skin's \"geom\" grouping");
+  const std::vector<int>& sensor_geoms = it->second;
   geoms_.assign(sensor_geoms.begin(), sensor_geoms.end());
   std::sort(geoms_.begin(), geoms_.end());
   geoms_.erase(std::unique(geoms_.begin(), geoms_.end()), geoms_.end());
@@ -167,7 +171,7 @@ void ObsBatch::assign(long begin, const ObsBatch& source) {
 // Pipeline
 
 ObservationPipeline::ObservationPipeline(const DictSpace& space, const ObservationConfig& config,
-                                         const senses::Touch* touch)
+                                         const envs::ObservationLayout* touch)
     : config_(config) {
   int offset = 0;
   for (int key = 0; key < static_cast<int>(space.entries.size()); ++key) {
@@ -179,9 +183,9 @@ ObservationPipeline::ObservationPipeline(const DictSpace& space, const Observati
       continue;
     }
     Segment segment{.key = key, .dtype = box.dtype, .offset = offset, .size = box.size()};
-    if (name == envs::BabyBenchEnv::kTouchKey && config.pool_touch) {
+    if (name == kTouchKey && config.pool_touch) {
       if (touch == nullptr) {
-        throw UserError("pool_touch needs the env's skin; pass LearnerOptions::touch");
+        throw UserError("pool_touch needs the skin layout the env publishes for \"touch\"");
       }
       pooling_ = std::make_unique<TouchPooling>(*touch);
       if (pooling_->input_size() != box.size()) {

@@ -23,10 +23,6 @@
 #include "envs/env.h"
 #include "learn/hyperparams.h"
 
-namespace cradle::senses {
-class Touch;
-}
-
 namespace cradle::learn {
 
 class VecEnv;
@@ -41,16 +37,16 @@ struct ObservationConfig {
   void check_matches(const std::string& checkpoint_config) const;
 };
 
-// The skin behind a VecEnv's "touch" observation: `given` if set, else env(0)'s when it is a
-// BabyBenchEnv with touch, else null.
-const senses::Touch* find_touch(const VecEnv& env, const senses::Touch* given);
+// The layout env(0) publishes for its "touch" observation (null: none, or no envs).
+const envs::ObservationLayout* find_touch(const VecEnv& env);
 
-// Sums the force magnitude of each geom's sensors: one output per MIMo geom with at least one
-// sensor, in ascending geom id. A sensor's magnitude is |value| for the normal function and the
-// Euclidean norm of its 3 values for the force-vector functions.
+// Sums the force magnitude of each geom's sensors: one output per geom with at least one sensor
+// (the layout's "geom" grouping), in ascending geom id. A sensor's magnitude is |value| with one
+// value per sensor (the normal function) and the Euclidean norm of its 3 values otherwise.
 class TouchPooling {
  public:
-  explicit TouchPooling(const senses::Touch& touch);
+  // Throws UserError when the layout has no "geom" grouping.
+  explicit TouchPooling(const envs::ObservationLayout& skin);
   int size() const { return static_cast<int>(geoms_.size()); }
   int input_size() const { return sensors_ * values_per_sensor_; }
   const std::vector<int>& geoms() const { return geoms_; }  // geom id of each output
@@ -121,9 +117,10 @@ struct ObsBatch {
 // other key is flattened into the vector.
 class ObservationPipeline {
  public:
-  // `touch` is required when pooling a space that has a "touch" key (UserError otherwise).
+  // `touch` (the skin's layout) is required when pooling a space that has a "touch" key
+  // (UserError otherwise).
   ObservationPipeline(const DictSpace& space, const ObservationConfig& config,
-                      const senses::Touch* touch);
+                      const envs::ObservationLayout* touch);
   const ObsShape& shape() const { return shape_; }
   const ObservationConfig& config() const { return config_; }
   // Writes env i's observation into row i of `out` (env.num_envs() rows). With update_stats the

@@ -80,12 +80,4 @@ class ThreadedVecEnv final : public VecEnv {
   std::function<void()> after_step_, after_reset_;
 };
 
-// BabyBench envs sharing one set of assets (one compiled model; each env still holds its own
-// mjData, about 300 MB with the reference scenes' njmax = 5000). training = true prepares
-// <save_dir> as envs::make_env does and attaches one shared training log to every env, written in
-// env order; continue_log >= 0 continues the log that holds that many entries (resume).
-std::unique_ptr<ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
-                                                       int threads, bool training,
-                                                       std::uint64_t seed, long continue_log = -1);
-
 }  // namespace cradle::learn

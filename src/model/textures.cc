@@ -3,8 +3,6 @@
 // seams and a feature may span two faces.
 #include "model/textures.h"
 
-#include <stb_image_write.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -507,19 +505,6 @@ std::string material_xml(const MaterialAsset& material) {
   if (!material.texture.empty()) xml += " texture=\"" + material.texture + "\"";
   if (!material.attributes.empty()) xml += " " + material.attributes;
   return xml + "/>";
-}
-
-std::vector<std::uint8_t> encode_png(const Image& image) {
-  std::vector<std::uint8_t> png;
-  // stb hands the encoded stream over in one or more chunks.
-  const auto append = [](void* context, void* data, int size) {
-    auto* out = static_cast<std::vector<std::uint8_t>*>(context);
-    const auto* bytes = static_cast<const std::uint8_t*>(data);
-    out->insert(out->end(), bytes, bytes + size);
-  };
-  stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(),
-                         image.width * 3);
-  return png;
 }
 
 const std::vector<std::string>& emote_names() {

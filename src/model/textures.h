@@ -7,15 +7,12 @@
 #include <utility>
 #include <vector>
 
+#include "core/image.h"
 #include "model/infant.h"
 
 namespace cradle::model {
 
-struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgb;  // row-major, row 0 at the top, 3 bytes per pixel
-};
+using cradle::Image;
 
 struct TextureAsset {
   std::string name;
@@ -41,8 +38,7 @@ std::string texture_file_name(const TextureAsset& texture, const std::string& at
 std::string texture_xml(const TextureAsset& texture);
 std::string material_xml(const MaterialAsset& material);
 
-// PNG encoding of an image (stb_image_write).
-std::vector<std::uint8_t> encode_png(const Image& image);
+using cradle::encode_png;
 
 // The infant's textures and materials. Material names used by the body tables: skin, head,
 // eye_left, eye_right, top_up, top_middle, top_down, sleeve, pants_up, pants_down, sock. Head

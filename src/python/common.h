@@ -36,7 +36,9 @@ py::array view_array(const Entry& entry, std::span<const std::byte> data, py::ha
 py::array view_doubles(const double* data, py::ssize_t n, py::handle owner);
 
 // The reference's info dict of a behaviour (Cradle's extra hand-regard keys included).
-py::dict info_dict(Behavior behavior, const envs::Info& info);
+// The info's published keys (in declaration order) and "steps"; info_value: one key's value.
+py::object info_value(const envs::Info& info, int slot);
+py::dict info_dict(const envs::Info& info);
 
 // A space as Python data: [(key, shape tuple, dtype name, low array, high array), ...].
 py::tuple box_tuple(const Box& box);

@@ -155,7 +155,7 @@ class PyEnv {
     return d;
   }
 
-  py::dict info() const { return info_dict(env_->config().behavior, env_->info()); }
+  py::dict info() const { return info_dict(env_->info()); }
 
   // Renders a model camera at width x height (RGB, row 0 at the top).
   py::array render(const IdOrName& camera, int width, int height) {

@@ -16,9 +16,10 @@
 #include "eval/evaluation.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
-#include "learn/trainer.h"
 #include "learn/vector_env.h"
 #include "python/common.h"
+#include "train/babybench_vector.h"
+#include "train/trainer.h"
 
 namespace cradle::python {
 namespace {
@@ -49,11 +50,11 @@ class PyVecEnv {
  public:
   PyVecEnv(const Config& config, int num_envs, int threads, bool training, std::uint64_t seed,
            bool same_step)
-      : behavior_(config.behavior), same_step_(same_step) {
+      : same_step_(same_step) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1");
     {
       py::gil_scoped_release release;
-      vec_ = learn::make_babybench_vec_env(config, num_envs, threads, training, seed);
+      vec_ = train::make_babybench_vec_env(config, num_envs, threads, training, seed);
     }
     entries_ = entries_of(vec_->observation_space());
   }
@@ -112,7 +113,7 @@ class PyVecEnv {
                 copy_array(entries_[k], vec_->observation(i).bytes(static_cast<int>(k)));
           }
           final_obs[i] = o;
-          final_info[i] = info_dict(behavior_, vec_->info(i));
+          final_info[i] = info_dict(vec_->info(i));
         }
       }
       {
@@ -153,13 +154,11 @@ class PyVecEnv {
   void clear_stepping() { stepping_ = 0; }
 
   // The env i's info dict.
-  py::dict info(int i) const { return info_dict(behavior_, vec_->info(i)); }
+  py::dict info(int i) const { return info_dict(vec_->info(i)); }
 
   void close() {
     if (!vec_) return;
-    for (int i = 0; i < vec_->num_envs(); ++i) {
-      dynamic_cast<envs::BabyBenchEnv&>(vec_->env(i)).close();
-    }
+    for (int i = 0; i < vec_->num_envs(); ++i) vec_->env(i).close();
   }
 
  private:
@@ -193,39 +192,49 @@ class PyVecEnv {
     py::dict out;
     py::array_t<bool> all(envs);
     for (int i = 0; i < envs; ++i) all.mutable_at(i) = true;
-    auto ints = [&](auto get) {
-      py::array_t<std::int64_t> a(envs);
-      for (int i = 0; i < envs; ++i) a.mutable_at(i) = get(vec_->info(i));
-      return a;
+    auto put = [&](const std::string& key, py::object value) {
+      out[key.c_str()] = value;
+      out[("_" + key).c_str()] = all;
     };
-    auto put = [&](const char* key, py::object value) {
-      out[key] = value;
-      out[("_" + std::string(key)).c_str()] = all;
-    };
-    if (behavior_ == Behavior::kSelfTouch) {
-      std::vector<py::object> right(envs), left(envs);
-      for (int i = 0; i < envs; ++i) {
-        right[i] = py::cast(vec_->info(i).right_hand_touches);
-        left[i] = py::cast(vec_->info(i).left_hand_touches);
+    // One array per published key: lists as an object array, numbers by their type.
+    const envs::Info& first = vec_->info(0);
+    for (int k = 0; k < first.size(); ++k) {
+      if (!first.published(k)) continue;
+      switch (first.type(k)) {
+        case envs::InfoType::kIntList: {
+          std::vector<py::object> lists(envs);
+          for (int i = 0; i < envs; ++i) lists[i] = info_value(vec_->info(i), k);
+          put(first.name(k), object_array(std::move(lists)));
+          break;
+        }
+        case envs::InfoType::kBool: {
+          py::array_t<bool> a(envs);
+          for (int i = 0; i < envs; ++i) a.mutable_at(i) = vec_->info(i).flag(k);
+          put(first.name(k), a);
+          break;
+        }
+        case envs::InfoType::kInt: {
+          py::array_t<std::int64_t> a(envs);
+          for (int i = 0; i < envs; ++i) {
+            a.mutable_at(i) = static_cast<std::int64_t>(vec_->info(i).number(k));
+          }
+          put(first.name(k), a);
+          break;
+        }
+        case envs::InfoType::kReal: {
+          py::array_t<double> a(envs);
+          for (int i = 0; i < envs; ++i) a.mutable_at(i) = vec_->info(i).number(k);
+          put(first.name(k), a);
+          break;
+        }
       }
-      put("right_hand_touches", object_array(std::move(right)));
-      put("left_hand_touches", object_array(std::move(left)));
-    } else if (behavior_ == Behavior::kHandRegard) {
-      const char* names[] = {"right_eye_right_hand", "right_eye_left_hand", "left_eye_right_hand",
-                             "left_eye_left_hand"};
-      for (int k = 0; k < 4; ++k) {
-        put(names[k], ints([k](const envs::Info& in) { return in.hand_regard[k]; }));
-      }
-      put("right_eye_either_hand",
-          ints([](const envs::Info& in) { return in.hand_regard_either[0]; }));
-      put("left_eye_either_hand",
-          ints([](const envs::Info& in) { return in.hand_regard_either[1]; }));
     }
-    put("steps", ints([](const envs::Info& in) { return in.steps; }));
+    py::array_t<std::int64_t> steps(envs);
+    for (int i = 0; i < envs; ++i) steps.mutable_at(i) = vec_->info(i).steps;
+    put("steps", steps);
     return out;
   }
 
-  Behavior behavior_;
   bool same_step_;
   std::unique_ptr<learn::ThreadedVecEnv> vec_;
   std::vector<Entry> entries_;
@@ -247,8 +256,7 @@ struct PyTerm {
 // views of the envs' buffers, valid only during the call.
 class PyRewardHook {
  public:
-  PyRewardHook(std::vector<PyTerm> terms, Behavior behavior)
-      : terms_(std::move(terms)), behavior_(behavior) {}
+  explicit PyRewardHook(std::vector<PyTerm> terms) : terms_(std::move(terms)) {}
 
   void operator()(const learn::VecEnv& env, std::span<const double> actions,
                   std::span<double> rewards) {
@@ -276,7 +284,7 @@ class PyRewardHook {
           if (!action) {
             action =
                 view_doubles(actions.data() + i * dim, static_cast<py::ssize_t>(dim), py::tuple());
-            info = info_dict(behavior_, env.info(i));
+            info = info_dict(env.info(i));
           }
           r = t.fn(obs_[i], action, info).cast<double>();
         } else {
@@ -289,7 +297,6 @@ class PyRewardHook {
 
  private:
   std::vector<PyTerm> terms_;
-  Behavior behavior_;
   std::vector<py::dict> obs_;  // per env: views of its observation buffers
 };
 
@@ -351,7 +358,7 @@ void bind_learn(py::module_& m) {
          long checkpoint_every, const std::map<std::string, std::string>& hyperparameters,
          int eval_episodes, int eval_duration, bool eval_render, bool compare_random,
          bool progress_bar, const py::list& terms) {
-        learn::TrainOptions o{.algorithm = algorithm,
+        train::TrainOptions o{.algorithm = algorithm,
                               .intrinsic = intrinsic,
                               .steps = steps,
                               .envs = envs,
@@ -371,13 +378,13 @@ void bind_learn(py::module_& m) {
           const py::tuple tt = py::reinterpret_borrow<py::tuple>(t);
           py_terms.push_back({tt[0].cast<py::object>(), tt[1].cast<double>(), tt[2].cast<bool>()});
         }
-        auto hook = std::make_shared<PyRewardHook>(std::move(py_terms), config.behavior);
+        auto hook = std::make_shared<PyRewardHook>(std::move(py_terms));
         o.reward_hook = [hook](const learn::VecEnv& env, std::span<const double> actions,
                                std::span<double> rewards) { (*hook)(env, actions, rewards); };
-        learn::TrainResult r;
+        train::TrainResult r;
         {
           py::gil_scoped_release release;
-          r = learn::train(config, o);
+          r = train::train(config, o);
         }
         py::dict out;
         out["steps"] = r.steps;
@@ -404,7 +411,7 @@ void bind_learn(py::module_& m) {
       "load_policy",
       [](const Config& config, const std::string& checkpoint) {
         py::gil_scoped_release release;
-        PyPolicy p{learn::load_policy(config, checkpoint)};
+        PyPolicy p{train::load_policy(config, checkpoint)};
         return p;
       },
       py::arg("config"), py::arg("checkpoint"));
@@ -424,7 +431,7 @@ void bind_learn(py::module_& m) {
           p = policy.cast<const PyPolicy&>().policy;
         } else if (py::isinstance<py::str>(policy)) {
           py::gil_scoped_release release;
-          p = learn::load_policy(config, policy.cast<std::string>());
+          p = train::load_policy(config, policy.cast<std::string>());
         } else if (!policy.is_none()) {
           p = python_policy(policy);
         }

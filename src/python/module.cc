@@ -49,18 +49,25 @@ py::array view_doubles(const double* data, py::ssize_t n, py::handle owner) {
   return out;
 }
 
-py::dict info_dict(Behavior behavior, const envs::Info& info) {
+py::object info_value(const envs::Info& info, int slot) {
+  switch (info.type(slot)) {
+    case envs::InfoType::kBool:
+      return py::bool_(info.flag(slot));
+    case envs::InfoType::kInt:
+      return py::int_(static_cast<long>(info.number(slot)));
+    case envs::InfoType::kReal:
+      return py::float_(info.number(slot));
+    case envs::InfoType::kIntList:
+      break;
+  }
+  const std::span<const int> list = info.list(slot);
+  return py::cast(std::vector<int>(list.begin(), list.end()));
+}
+
+py::dict info_dict(const envs::Info& info) {
   py::dict d;
-  if (behavior == Behavior::kSelfTouch) {
-    d["right_hand_touches"] = py::cast(info.right_hand_touches);
-    d["left_hand_touches"] = py::cast(info.left_hand_touches);
-  } else if (behavior == Behavior::kHandRegard) {
-    d["right_eye_right_hand"] = info.hand_regard[0];
-    d["right_eye_left_hand"] = info.hand_regard[1];
-    d["left_eye_right_hand"] = info.hand_regard[2];
-    d["left_eye_left_hand"] = info.hand_regard[3];
-    d["right_eye_either_hand"] = info.hand_regard_either[0];
-    d["left_eye_either_hand"] = info.hand_regard_either[1];
+  for (int k = 0; k < info.size(); ++k) {
+    if (info.published(k)) d[info.name(k).c_str()] = info_value(info, k);
   }
   d["steps"] = info.steps;
   return d;

@@ -8,36 +8,18 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using CliResult = cradle::test::RunResult;
+using cradle::test::run_cradle;
 
-CliResult cradle(const std::string& args) {
-  const std::string cmd = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
-}
+std::string config(const char* name) { return cradle::test::config_path(name).string(); }
 
-std::string config(const char* name) {
-  return (fs::path(CRADLE_SOURCE_DIR) / "configs" / name).string();
-}
-
-fs::path temp_dir(const char* tag) {
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("cradle_cli_") + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path temp_dir(const char* tag) { return cradle::test::fresh_dir(std::string("cli_") + tag); }
 
 int lines(const std::string& s) {
   int n = 0;
@@ -65,7 +47,7 @@ std::string write_training_config(const fs::path& dir) {
 TEST(Cli, BuildSceneWritesSceneAndTextures) {
   const fs::path dir = temp_dir("build");
   const CliResult r =
-      cradle("build-scene --config " + config("config_selftouch.yml") + " --out " + dir.string());
+      run_cradle("build-scene --config " + config("config_selftouch.yml") + " --out " + dir.string());
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(fs::exists(dir / "scene.xml"));
   EXPECT_TRUE(fs::exists(dir / "tex_head_default_right.png"));
@@ -73,7 +55,7 @@ TEST(Cli, BuildSceneWritesSceneAndTextures) {
 }
 
 TEST(Cli, ModelInfoJsonHasReferenceCounts) {
-  const CliResult r = cradle("model-info --json --config " + config("config_handregard.yml"));
+  const CliResult r = run_cradle("model-info --json --config " + config("config_handregard.yml"));
   ASSERT_EQ(r.status, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["mimo_version"], "v2");
@@ -94,25 +76,25 @@ TEST(Cli, ModelInfoJsonHasReferenceCounts) {
 TEST(Cli, BadConfigGivesOneLineError) {
   const fs::path dir = temp_dir("bad");
   std::ofstream(dir / "bad.yml") << "scene: kitchen\n";
-  CliResult r = cradle("model-info --config " + (dir / "bad.yml").string());
+  CliResult r = run_cradle("model-info --config " + (dir / "bad.yml").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(lines(r.out), 1) << r.out;
   EXPECT_NE(r.out.find("scene"), std::string::npos);
   EXPECT_NE(r.out.find("kitchen"), std::string::npos);
 
-  r = cradle("model-info --config " + (dir / "missing.yml").string());
+  r = run_cradle("model-info --config " + (dir / "missing.yml").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(lines(r.out), 1) << r.out;
   EXPECT_NE(r.out.find("missing.yml"), std::string::npos);
 
-  r = cradle("bench --steps 0 --config " + config("config_selftouch.yml"));
+  r = run_cradle("bench --steps 0 --config " + config("config_selftouch.yml"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.out.find("--steps"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 
 TEST(Cli, BenchJsonReportsRatesAndModules) {
-  const CliResult r = cradle("bench --json --steps 200 --config " + config("config_selftouch.yml"));
+  const CliResult r = run_cradle("bench --json --steps 200 --config " + config("config_selftouch.yml"));
   ASSERT_EQ(r.status, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["env_steps_per_s"].get<double>(), 0);
@@ -135,17 +117,12 @@ nlohmann::json probe(const fs::path& video) {
       "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
       "stream=codec_name,width,height,nb_read_frames -of json " +
       video.string();
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) out += buf;
-  pclose(pipe);
-  return nlohmann::json::parse(out)["streams"][0];
+  return nlohmann::json::parse(cradle::test::run(cmd).out)["streams"][0];
 }
 
 TEST(Cli, TestInstallationWritesSceneLogAndVideo) {
   const fs::path dir = temp_dir("install");
-  const CliResult r = cradle("test-installation --save-dir " + (dir / "out").string());
+  const CliResult r = run_cradle("test-installation --save-dir " + (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("passed"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "out" / "scene.xml"));
@@ -166,19 +143,15 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
       << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
       << "\nvision_active: False\nmax_episode_steps: 50\n"
          "touch_function: force_vector\n";
-  CliResult r = cradle("random --config " + (dir / "config.yml").string() + " --train_for 120");
+  CliResult r = run_cradle("random --config " + (dir / "config.yml").string() + " --train_for 120");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("training score"), std::string::npos) << r.out;
 
   const fs::path elsewhere = dir / "elsewhere";
   fs::create_directories(elsewhere);
-  const std::string cmd = "cd " + elsewhere.string() + " && " + std::string(CRADLE_BINARY) +
-                          " evaluate --config ../config.yml --episodes 2 --duration 30 2>&1";
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) out += buf;
-  ASSERT_EQ(WEXITSTATUS(pclose(pipe)), 0) << out;
+  const CliResult evaluated =
+      run_cradle("evaluate --config ../config.yml --episodes 2 --duration 30", elsewhere);
+  ASSERT_EQ(evaluated.status, 0) << evaluated.out;
   const fs::path run = dir / "run";
   for (const char* file :
        {"evaluation.json", "trajectories/episode_0.npz", "trajectories/episode_1.npz",
@@ -194,11 +167,7 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
     const std::string py = "/usr/bin/python3 -c \"import numpy as n, json; d = n.load('" +
                            (run / "trajectories" / "episode_0.npz").string() +
                            "'); print(d['qpos'].shape, json.loads(d['info'][-1])['steps'])\"";
-    std::string shape;
-    FILE* p = popen(py.c_str(), "r");
-    while (fgets(buf, sizeof(buf), p)) shape += buf;
-    pclose(p);
-    EXPECT_EQ(shape, "(30, 54) 29\n");
+    EXPECT_EQ(cradle::test::run(py).out, "(30, 54) 29\n");
   }
   std::ifstream in(run / "evaluation.json");
   const nlohmann::json report = nlohmann::json::parse(in);
@@ -217,7 +186,7 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
   const std::string train = "train --config " + write_training_config(dir) +
                             " --envs 1 --hp n_steps=128 batch_size=64 n_epochs=1"
                             " --eval-episodes 0 --checkpoint-every 128 --no-eval-video";
-  CliResult r = cradle(train + " --steps 256");
+  CliResult r = run_cradle(train + " --steps 256");
   ASSERT_EQ(r.status, 0) << r.out;
   const fs::path csv = dir / "run" / "logs" / "progress.csv";
   std::vector<std::string> rows = read_lines(csv);
@@ -226,7 +195,7 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
   EXPECT_EQ(rows[2].substr(0, 4), "256,");
 
   // Same columns: appended.
-  r = cradle(train + " --steps 384 --resume");
+  r = run_cradle(train + " --steps 384 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   rows = read_lines(csv);
   ASSERT_EQ(rows.size(), 4u);
@@ -234,7 +203,7 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
 
   // Other columns: the old file is renamed, a new one started.
   std::ofstream(csv) << "global_step,time\n128,1.0\n";
-  r = cradle(train + " --steps 512 --resume");
+  r = run_cradle(train + " --steps 512 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(read_lines(dir / "run" / "logs" / "progress.before-resume.csv").size(), 2u);
   rows = read_lines(csv);
@@ -243,7 +212,7 @@ TEST(Cli, TrainResumesAndKeepsAnOlderProgressFileAside) {
 
   // Resuming with nothing to resume from is a one-line error.
   fs::remove_all(dir / "run" / "checkpoints");
-  r = cradle(train + " --steps 640 --resume");
+  r = run_cradle(train + " --steps 640 --resume");
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(lines(r.out), 1) << r.out;
 }
@@ -254,9 +223,9 @@ TEST(Cli, SacResumesFromItsCheckpoint) {
   const std::string train = "train --algo sac --config " + write_training_config(dir) +
                             " --envs 1 --hp learning_starts=32 batch_size=16 report_every=64"
                             " --eval-episodes 0 --checkpoint-every 64 --no-eval-video";
-  CliResult r = cradle(train + " --steps 128");
+  CliResult r = run_cradle(train + " --steps 128");
   ASSERT_EQ(r.status, 0) << r.out;
-  r = cradle(train + " --steps 192 --resume");
+  r = run_cradle(train + " --steps 192 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   std::vector<std::string> steps;
   for (const std::string& line : read_lines(dir / "run" / "logs" / "progress.csv")) {

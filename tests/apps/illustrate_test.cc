@@ -10,25 +10,17 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using CliResult = cradle::test::RunResult;
 
 // Runs cradle in `dir` (illustrate writes models/ under the working folder).
 CliResult cradle_in(const fs::path& dir, const std::string& args) {
-  const std::string cmd =
-      "cd '" + dir.string() + "' && " + std::string(CRADLE_BINARY) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
+  return cradle::test::run_cradle(args, dir);
 }
 
 int lines(const std::string& s) {

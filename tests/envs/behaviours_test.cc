@@ -69,6 +69,18 @@ std::vector<std::string> arm(const std::string& side) {
           side + "_hand3"};
 }
 
+// An info list or number by key (the key must be declared).
+std::vector<int> list(const Info& info, const char* key) {
+  const int k = info.find(key);
+  EXPECT_GE(k, 0) << key;
+  return k < 0 ? std::vector<int>{} : std::vector<int>(info.list(k).begin(), info.list(k).end());
+}
+double value(const Info& info, const char* key) {
+  const int k = info.find(key);
+  EXPECT_GE(k, 0) << key;
+  return k < 0 ? -1 : info.number(k);
+}
+
 bool contains(const std::vector<int>& list, int value) {
   return std::find(list.begin(), list.end(), value) != list.end();
 }
@@ -84,14 +96,15 @@ TEST(SelfTouch, LeftHandOnRightForearmIsRecordedByTheLeftHand) {
   });
   SelfTouch task(m.get());
   Info info;
+  task.declare(info);
   task.reset(m.get(), d, info);
   task.after_step(m.get(), d, info);
-  EXPECT_TRUE(contains(info.left_hand_touches, forearm_geom)) << "ncon " << d->ncon;
-  EXPECT_FALSE(contains(info.right_hand_touches, forearm_geom));
+  EXPECT_TRUE(contains(list(info, "left_hand_touches"), forearm_geom)) << "ncon " << d->ncon;
+  EXPECT_FALSE(contains(list(info, "right_hand_touches"), forearm_geom));
   // Lists hold unique ids in order of first contact: a second step adds nothing new.
-  const auto before = info.left_hand_touches;
+  const std::vector<int> before = list(info, "left_hand_touches");
   task.after_step(m.get(), d, info);
-  EXPECT_EQ(info.left_hand_touches, before);
+  EXPECT_EQ(list(info, "left_hand_touches"), before);
   mj_deleteData(d);
 }
 
@@ -110,21 +123,22 @@ TEST(SelfTouch, HandOnHandIsRecordedByBothAndOwnGeomsNever) {
   ASSERT_LT(distance(d->geom_xpos + 3 * right_palm, d->geom_xpos + 3 * left_palm), 0.02);
   SelfTouch task(m.get());
   Info info;
+  task.declare(info);
   task.reset(m.get(), d, info);
   task.after_step(m.get(), d, info);
-  ASSERT_FALSE(info.right_hand_touches.empty()) << "ncon " << d->ncon;
-  ASSERT_FALSE(info.left_hand_touches.empty());
+  ASSERT_FALSE(list(info, "right_hand_touches").empty()) << "ncon " << d->ncon;
+  ASSERT_FALSE(list(info, "left_hand_touches").empty());
   // Each hand records a geom of the other hand: symmetric, unlike the reference.
   const auto& right_geoms = task.hand_geoms(0);
   const auto& left_geoms = task.hand_geoms(1);
   auto any_of = [](const std::vector<int>& list, const std::vector<int>& geoms) {
     return std::any_of(list.begin(), list.end(), [&](int g) { return contains(geoms, g); });
   };
-  EXPECT_TRUE(any_of(info.right_hand_touches, left_geoms));
-  EXPECT_TRUE(any_of(info.left_hand_touches, right_geoms));
+  EXPECT_TRUE(any_of(list(info, "right_hand_touches"), left_geoms));
+  EXPECT_TRUE(any_of(list(info, "left_hand_touches"), right_geoms));
   // A hand never records its own palm or fingers.
-  EXPECT_FALSE(any_of(info.right_hand_touches, right_geoms));
-  EXPECT_FALSE(any_of(info.left_hand_touches, left_geoms));
+  EXPECT_FALSE(any_of(list(info, "right_hand_touches"), right_geoms));
+  EXPECT_FALSE(any_of(list(info, "left_hand_touches"), left_geoms));
   mj_deleteData(d);
 }
 
@@ -158,10 +172,11 @@ TEST(HandRegard, HandInFrontOfTheEyeCountsBehindTheHeadDoesNot) {
   });
   EXPECT_LT(task.gaze_angle(d, 0, 0), 15);
   Info info;
+  task.declare(info);
   task.reset(m.get(), d, info);
   task.after_step(m.get(), d, info);
-  EXPECT_EQ(info.hand_regard[0], 1);  // right eye, right hand
-  EXPECT_EQ(info.hand_regard_either[0], 1);
+  EXPECT_EQ(value(info, "right_eye_right_hand"), 1);  // right eye, right hand
+  EXPECT_EQ(value(info, "right_eye_either_hand"), 1);
 
   // The same hand behind the head.
   search(m.get(), d, arm("right"), [&](const mjData* x) {
@@ -174,7 +189,7 @@ TEST(HandRegard, HandInFrontOfTheEyeCountsBehindTheHeadDoesNot) {
   });
   EXPECT_GT(task.gaze_angle(d, 0, 0), 90);
   task.after_step(m.get(), d, info);
-  EXPECT_EQ(info.hand_regard[0], 1);  // unchanged
+  EXPECT_EQ(value(info, "right_eye_right_hand"), 1);  // unchanged
   mj_deleteData(d);
 }
 
@@ -203,12 +218,14 @@ TEST(HandRegard, OccludedHandNotCountedWithOcclusionOn) {
   mj_forward(m.get(), d);
   EXPECT_FALSE(occluding.visible(m.get(), d, 0, 0));
   Info a, b;
+  plain.declare(a);
+  occluding.declare(b);
   plain.reset(m.get(), d, a);
   occluding.reset(m.get(), d, b);
   plain.after_step(m.get(), d, a);
   occluding.after_step(m.get(), d, b);
-  EXPECT_EQ(a.hand_regard[0], 1);
-  EXPECT_EQ(b.hand_regard[0], 0);
+  EXPECT_EQ(value(a, "right_eye_right_hand"), 1);
+  EXPECT_EQ(value(b, "right_eye_right_hand"), 0);
   mj_deleteData(d);
 }
 

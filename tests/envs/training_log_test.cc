@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "core/jsonl.h"
 #include "envs/babybench.h"
+#include "envs/hand_regard.h"
+#include "envs/self_touch.h"
 
 namespace cradle::envs {
 namespace {
@@ -47,14 +51,57 @@ TEST(TrainingLog, EpisodesAreAppendedAndReloaded) {
   fs::remove_all(dir);
 }
 
-TEST(TrainingLog, EpisodeScores) {
+// Tasks own their scores: self-touch (|right| + |left|) / 68, hand regard the mean fraction of
+// steps each eye-hand pair was in view, none measures nothing.
+TEST(TrainingLog, EpisodeScoresAreTheTasks) {
+  Config config = load_config(fs::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
+  const auto selftouch = make_assets(config);
+  SelfTouch touch(selftouch->model.get());
   Info info;
-  info.right_hand_touches = {1, 2, 3};
-  info.left_hand_touches = {4};
-  EXPECT_DOUBLE_EQ(episode_score(Behavior::kSelfTouch, info, 10), 4.0 / 68);
-  info.hand_regard = {10, 0, 10, 20};
-  EXPECT_DOUBLE_EQ(episode_score(Behavior::kHandRegard, info, 100), 40.0 / 400);
-  EXPECT_TRUE(std::isnan(episode_score(Behavior::kNone, info, 100)));
+  touch.declare(info);
+  info.list(info.find("right_hand_touches")) = {1, 2, 3};
+  info.list(info.find("left_hand_touches")) = {4};
+  EXPECT_DOUBLE_EQ(touch.score(info, 10), 4.0 / 68);
+
+  config = load_config(fs::path(CRADLE_SOURCE_DIR) / "configs" / "config_handregard.yml");
+  config.vision_active = false;
+  const auto handregard = make_assets(config);
+  HandRegard regard(handregard->model.get(), 15, false);
+  Info seen;
+  regard.declare(seen);
+  const char* pairs[4] = {"right_eye_right_hand", "right_eye_left_hand", "left_eye_right_hand",
+                          "left_eye_left_hand"};
+  const double steps_in_view[4] = {10, 0, 10, 20};
+  for (int k = 0; k < 4; ++k) seen.set(seen.find(pairs[k]), steps_in_view[k]);
+  EXPECT_DOUBLE_EQ(regard.score(seen, 100), 40.0 / 400);
+  EXPECT_DOUBLE_EQ(regard.score(seen, 0), 0);
+
+  config.behavior = Behavior::kNone;
+  EXPECT_TRUE(std::isnan(make_behaviour(config, handregard->model.get())->score(seen, 100)));
+}
+
+// The open info: declared keys in order, typed JSON, unpublished keys kept out, clear() keeps keys.
+TEST(Info, DeclaredKeysConvertGenerically) {
+  Info info;
+  const int flag = info.declare("is_success", InfoType::kBool);
+  const int count = info.declare("count", InfoType::kInt);
+  const int list = info.declare("touches", InfoType::kIntList);
+  const int hidden = info.declare("contacts", InfoType::kIntList, /*published=*/false);
+  EXPECT_THROW(info.declare("count", InfoType::kReal), std::logic_error);
+  EXPECT_EQ(info.find("touches"), list);
+  EXPECT_EQ(info.find("absent"), -1);
+  info.set(flag, 1);
+  info.add(count, 2);
+  info.add(count, 3);
+  info.list(list) = {7, 8};
+  info.list(hidden) = {9};
+  info.steps = 4;
+  const nlohmann::json j = info.to_json();
+  EXPECT_EQ(j.dump(), R"({"count":5,"is_success":true,"steps":4,"touches":[7,8]})");
+  info.clear();
+  EXPECT_EQ(info.size(), 4);
+  EXPECT_EQ(info.to_json().dump(), R"({"count":0,"is_success":false,"steps":0,"touches":[]})");
+  EXPECT_TRUE(info.list(hidden).empty());
 }
 
 }  // namespace

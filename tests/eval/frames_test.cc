@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "core/config.h"
+#include "core/image.h"
 #include "core/rng.h"
 #include "envs/babybench.h"
 #include "envs/self_touch.h"
-#include "eval/plot.h"
 
 namespace cradle::eval {
 namespace {

@@ -121,7 +121,7 @@ TEST(TouchPooling, OneSumOfForceMagnitudesPerGeomWithSensors) {
   const auto assets = envs::make_assets(selftouch_config());
   const senses::Touch& touch = *assets->touch;
   ASSERT_EQ(touch.values_per_sensor(), 3);  // force_vector
-  const TouchPooling pooling(touch);
+  const TouchPooling pooling(assets->touch_layout);
 
   // One output per MIMo geom that carries sensors.
   std::vector<int> sensors_on_geom(assets->model->ngeom, 0);
@@ -155,7 +155,9 @@ TEST(TouchPooling, OneSumOfForceMagnitudesPerGeomWithSensors) {
   const envs::BabyBenchEnv env(assets);
   const DictSpace& space = env.observation_space();
   const int proprio = space.find("observation")->size();
-  ObservationPipeline pooled_pipeline(space, {}, &touch);
+  ASSERT_EQ(env.layout("touch"), &assets->touch_layout);  // the env publishes its skin
+  EXPECT_EQ(env.layout("observation"), nullptr);
+  ObservationPipeline pooled_pipeline(space, {}, env.layout("touch"));
   EXPECT_EQ(pooled_pipeline.shape().vector_size, proprio + pooling.size() + 6);
   ObservationPipeline raw_pipeline(space, {.pool_touch = false}, nullptr);
   EXPECT_EQ(raw_pipeline.shape().vector_size, proprio + touch.size() + 6);

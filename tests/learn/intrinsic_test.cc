@@ -25,6 +25,7 @@
 #include "learn/vector_env.h"
 #include "scene/compose.h"
 #include "senses/vision.h"
+#include "train/babybench_vector.h"
 
 namespace cradle::learn::intrinsic {
 namespace {
@@ -32,8 +33,10 @@ namespace {
 // An env whose observation and info the test writes directly.
 class FakeEnv final : public envs::Env {
  public:
-  FakeEnv(const DictSpace& space, const Box& action)
-      : space_(space), action_(action), obs_(space) {}
+  FakeEnv(const DictSpace& space, const Box& action) : space_(space), action_(action), obs_(space) {
+    info_.declare("right_hand_touches", envs::InfoType::kIntList);
+    info_.declare("left_hand_touches", envs::InfoType::kIntList);
+  }
   const DictSpace& observation_space() const override { return space_; }
   const Box& action_space() const override { return action_; }
   void reset(std::optional<std::uint64_t>) override {}
@@ -79,6 +82,8 @@ class FakeVec final : public VecEnv {
 
   envs::ObservationBuffers& obs(int i) { return envs_[i]->obs(); }
   envs::Info& info(int i) { return envs_[i]->mutable_info(); }
+  // The self-touch list of env i's hand (0 right, 1 left).
+  std::vector<int>& touches(int i, int hand) { return info(i).list(hand); }
   void set_done(int i, bool done) { truncated_[i] = done; }
 
  private:
@@ -186,7 +191,7 @@ TEST(BodyPartNovelty, FirstTouchFullBonusRepeatsFadeHandsCountedApart) {
   reward.bind(vec);
   reward.reset(vec);
 
-  vec.info(0).right_hand_touches = {5};
+  vec.touches(0, 0) = {5};
   auto r = step(reward, vec);
   EXPECT_DOUBLE_EQ(r[0], 1.0);
   EXPECT_DOUBLE_EQ(r[1], 0.0);
@@ -197,17 +202,17 @@ TEST(BodyPartNovelty, FirstTouchFullBonusRepeatsFadeHandsCountedApart) {
     vec.set_done(0, true);
     step(reward, vec);  // the step that ends the episode
     vec.set_done(0, false);
-    vec.info(0).right_hand_touches.clear();
+    vec.touches(0, 0).clear();
     EXPECT_DOUBLE_EQ(step(reward, vec)[0], 0.0);  // the autoreset step
-    vec.info(0).right_hand_touches = {5};
+    vec.touches(0, 0) = {5};
     EXPECT_NEAR(step(reward, vec)[0], 1.0 / std::sqrt(1.0 + episode), 1e-12);
   }
   EXPECT_EQ(reward.first_touches(0, 5), 4);
 
   // The left hand's touches of the same geom are counted apart; in one step, two envs touching
   // the same geom both get the bonus of the counts before the step.
-  vec.info(0).left_hand_touches = {5, 7};
-  vec.info(1).left_hand_touches = {7};
+  vec.touches(0, 1) = {5, 7};
+  vec.touches(1, 1) = {7};
   r = step(reward, vec);
   EXPECT_DOUBLE_EQ(r[0], 2.0);
   EXPECT_DOUBLE_EQ(r[1], 1.0);
@@ -221,13 +226,13 @@ TEST(BodyPartNovelty, HandWithFewerDistinctGeomsWeighsMore) {
   FakeVec vec(1, touch_space(4));
   BodyPartNovelty reward(1.0, {.onset_weight = 0, .balance = 1});
   reward.bind(vec);
-  vec.info(0).right_hand_touches = {1, 2, 3};
+  vec.touches(0, 0) = {1, 2, 3};
   EXPECT_DOUBLE_EQ(step(reward, vec)[0], 3.0);  // equal counts (0, 0): weights 1
   // Right 3 distinct, left 0: w_left = 2 (1 + 3) / (2 + 0 + 3), w_right = 2 (1 + 0) / 5.
   EXPECT_DOUBLE_EQ(reward.hand_weight(1), 1.6);
   EXPECT_DOUBLE_EQ(reward.hand_weight(0), 0.4);
-  vec.info(0).left_hand_touches = {9};
-  vec.info(0).right_hand_touches.push_back(4);
+  vec.touches(0, 1) = {9};
+  vec.touches(0, 0).push_back(4);
   EXPECT_DOUBLE_EQ(step(reward, vec)[0], 1.6 + 0.4);
   BodyPartNovelty half(1.0, {.balance = 0.5});
   EXPECT_DOUBLE_EQ(half.hand_weight(0), 1.0);
@@ -238,7 +243,7 @@ TEST(BodyPartNovelty, SavesAndLoadsItsCounts) {
   BodyPartNovelty a(1.0, {.balance = 0}), b(1.0, {.balance = 0});
   a.bind(vec);
   b.bind(vec);
-  vec.info(0).right_hand_touches = {3};
+  vec.touches(0, 0) = {3};
   step(a, vec);
   const auto dir = std::filesystem::temp_directory_path() / "cradle_intrinsic_bpn";
   std::filesystem::create_directories(dir);
@@ -521,7 +526,7 @@ TEST(BodyPartNovelty, OnTheSelfTouchEnvCountsWhatInfoRecords) {
   Config config =
       load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_selftouch.yml");
   config.max_episode_steps = 60;
-  auto vec = make_babybench_vec_env(config, 2, 1, /*training=*/false, 3);
+  auto vec = train::make_babybench_vec_env(config, 2, 1, /*training=*/false, 3);
   BodyPartNovelty reward;
   reward.bind(*vec);
   vec->reset(3);
@@ -537,7 +542,9 @@ TEST(BodyPartNovelty, OnTheSelfTouchEnvCountsWhatInfoRecords) {
       EXPECT_GE(rewards[i], 0);
       EXPECT_TRUE(std::isfinite(rewards[i]));
       if (vec->terminated()[i] || vec->truncated()[i]) {
-        recorded += vec->info(i).right_hand_touches.size() + vec->info(i).left_hand_touches.size();
+        const envs::Info& info = vec->info(i);
+        recorded += info.list(info.find("right_hand_touches")).size() +
+                    info.list(info.find("left_hand_touches")).size();
       }
     }
   }

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "learn/learner.h"
+#include "learn/registry.h"
 #include "learn/replay_buffer.h"
 #include "test_tasks.h"
 

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "core/rng.h"
-#include "learn/learner.h"
+#include "learn/registry.h"
 #include "test_tasks.h"
 
 namespace cradle::learn {

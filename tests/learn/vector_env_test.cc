@@ -13,6 +13,7 @@
 #include "core/jsonl.h"
 #include "core/rng.h"
 #include "envs/babybench.h"
+#include "train/babybench_vector.h"
 
 namespace cradle::learn {
 namespace {
@@ -119,7 +120,7 @@ TEST(ThreadedVecEnv, NextStepAutoreset) {
     EXPECT_EQ(vec->truncated()[i], 0);
     EXPECT_EQ(vec->terminated()[i], 0);
     EXPECT_EQ(vec->info(i).steps, 0);
-    EXPECT_TRUE(vec->info(i).right_hand_touches.empty());
+    EXPECT_TRUE(vec->info(i).list(vec->info(i).find("right_hand_touches")).empty());
     EXPECT_EQ(static_cast<envs::BabyBenchEnv&>(vec->env(i)).episode_steps(), 0);
     // A new episode's first observation: the env's second reset from its derived seed.
     envs::BabyBenchEnv ref(assets);
@@ -181,8 +182,8 @@ std::vector<std::byte> snapshot(const ThreadedVecEnv& vec) {
 
 TEST(ThreadedVecEnv, SameBatchesForAnyThreadCount) {
   const Config config = self_touch(20);
-  const auto one = make_babybench_vec_env(config, 3, 1, /*training=*/false, 5);
-  const auto two = make_babybench_vec_env(config, 3, 2, /*training=*/false, 5);
+  const auto one = train::make_babybench_vec_env(config, 3, 1, /*training=*/false, 5);
+  const auto two = train::make_babybench_vec_env(config, 3, 2, /*training=*/false, 5);
   ASSERT_EQ(one->threads(), 1);
   ASSERT_EQ(two->threads(), 2);
   one->reset(11);
@@ -234,7 +235,7 @@ TEST(ThreadedVecEnv, TrainingWritesOneSharedLog) {
   Config config = self_touch(10);
   config.save_dir = dir.string();
   {
-    const auto vec = make_babybench_vec_env(config, 3, 2, /*training=*/true, 9);
+    const auto vec = train::make_babybench_vec_env(config, 3, 2, /*training=*/true, 9);
     EXPECT_TRUE(fs::exists(dir / "scene.xml"));
     EXPECT_TRUE(fs::is_directory(dir / "videos"));
     vec->reset(9);

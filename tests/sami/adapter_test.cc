@@ -22,7 +22,7 @@ TEST(SamiAdapter, ForwardsSpacesObservationsAndSuccess) {
   const std::vector<double> action(4, 0.0);
   const StepResult r = env->step(action);
   EXPECT_EQ(env->info().steps, 1);
-  EXPECT_EQ(env->info().is_success, r.terminated);
+  EXPECT_EQ(env->info().flag(env->info().find("is_success")), r.terminated);
   for (int i = 0; i < 3; ++i) {
     EXPECT_FLOAT_EQ(env->observation().f32(2)[i], adapter.sami().observation()[22 + i]);
   }

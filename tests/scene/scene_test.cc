@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/config.h"
+#include "fixture.h"
 #include "scene/compose.h"
 #include "scene/summary.h"
 
@@ -19,17 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Config reference_config(const char* name) {
-  return load_config(fs::path(CRADLE_SOURCE_DIR) / "configs" / name);
-}
+using test::reference_config;
 
-fs::path fresh_dir(const std::string& tag) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("cradle_scene_test_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir(const std::string& tag) { return test::fresh_dir("scene_test_" + tag); }
 
 TEST(Scene, EveryBehaviourSceneAndActuationCompiles) {
   for (Behavior behavior : {Behavior::kNone, Behavior::kSelfTouch, Behavior::kHandRegard}) {

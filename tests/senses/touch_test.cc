@@ -24,6 +24,7 @@
 
 #include "core/config.h"
 #include "core/error.h"
+#include "fixture.h"
 #include "model/infant.h"
 #include "scene/compose.h"
 
@@ -399,9 +400,7 @@ TEST(Touch, ReadIsSafeFromManyThreads) {
 // ---------------------------------------------------------------------------------------------
 // MIMo.
 
-Config reference_config(const char* name) {
-  return load_config(fs::path(CRADLE_SOURCE_DIR) / "configs" / name);
-}
+using test::reference_config;
 
 TEST(TouchScales, DefaultsFollowVersionAndGroups) {
   const auto v1 = default_touch_scales(model::MimoVersion::kV1, default_touch_groups(), 1.0);

@@ -24,8 +24,8 @@ TEST(TmaAdapter, SpacesObservationAndFailure) {
   for (int t = 0; t < 300 && !r.terminated; ++t) r = env.step(fold);
   EXPECT_TRUE(r.terminated);
   EXPECT_EQ(r.reward, -100.0);
-  EXPECT_TRUE(env.info().is_failure);
-  EXPECT_FALSE(env.info().is_success);
+  EXPECT_TRUE(env.info().flag(env.info().find("is_failure")));
+  EXPECT_FALSE(env.info().flag(env.info().find("is_success")));
   EXPECT_EQ(env.observation().f64(0)[1], env.env().observation()[1]);
 }
 

@@ -165,8 +165,8 @@ class CatchEnv final : public MimoEnv {
   double compute_reward() override {
     double reward = in_contact_ ? kContactReward : 0;
     if (assets().options.action_penalty) reward -= kCostWeight * sim().actuation().cost();
-    if (info().is_failure) reward -= kEndReward;
-    if (info().is_success) reward += kEndReward;
+    if (failure()) reward -= kEndReward;
+    if (success()) reward += kEndReward;
     return reward;
   }
 

@@ -58,7 +58,7 @@ class ReachEnv final : public MimoEnv {
   double compute_reward() override {
     double v[3];
     mju_sub3(v, data()->xpos + 3 * fingers_, target_pos());
-    return -mju_norm3(v) + (info().is_success ? kTouchReward : 0);
+    return -mju_norm3(v) + (success() ? kTouchReward : 0);
   }
 
   HeadTracking tracking_;

@@ -157,6 +157,7 @@ std::shared_ptr<const SampleAssets> make_sample_assets(std::string_view name,
   if (!def.touch.empty()) {
     assets->touch =
         std::make_unique<senses::Touch>(m, senses::TouchOptions{.body_scales = def.touch});
+    assets->touch_layout = skin_layout(*assets->touch);
   }
   return assets;
 }
@@ -214,6 +215,8 @@ MimoEnv::MimoEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
       achieved_index_(key_index(kAchievedKey)),
       desired_index_(key_index(kDesiredKey)),
       goal_(assets_->definition.goal_size, 0.0),
+      success_slot_(info_.declare("is_success", InfoType::kBool)),
+      failure_slot_(info_.declare("is_failure", InfoType::kBool)),
       rng_(seed) {
   const SampleDefinition& def = assets_->definition;
   if (def.vision) eyes_ = std::make_unique<senses::Eyes>(m_, assets_->options.vision_resolution);
@@ -236,6 +239,10 @@ mjModel* MimoEnv::own_model() {
   return own_.get();
 }
 
+const ObservationLayout* MimoEnv::layout(std::string_view key) const {
+  return key == kTouchKey && assets_->touch ? &assets_->touch_layout : nullptr;
+}
+
 int MimoEnv::key_index(std::string_view key) const {
   for (int i = 0; i < static_cast<int>(observation_space_.entries.size()); ++i) {
     if (observation_space_.entries[i].first == key) return i;
@@ -251,7 +258,7 @@ void MimoEnv::reset(std::optional<std::uint64_t> seed) {
   restore_init();
   reset_model();
   steps_ = 0;
-  info_ = Info{};
+  info_.clear();
   observe();
 }
 
@@ -277,10 +284,10 @@ StepResult MimoEnv::step(std::span<const double> action) {
 
   const Clock::time_point task_start = Clock::now();
   info_.steps = steps_;
-  info_.is_success = is_success();
-  info_.is_failure = is_failure();
+  info_.set(success_slot_, is_success());
+  info_.set(failure_slot_, is_failure());
   StepResult result;
-  result.terminated = assets_->done_active && (info_.is_success || info_.is_failure);
+  result.terminated = assets_->done_active && (success() || failure());
   ++steps_;
   const int limit = assets_->definition.max_episode_steps;
   result.truncated = limit > 0 && steps_ >= limit;

@@ -82,6 +82,7 @@ struct SampleAssets {
   scene::SceneFiles scene;
   scene::ModelPtr model;
   std::unique_ptr<senses::Touch> touch;  // null without touch
+  ObservationLayout touch_layout;        // the skin's layout, published as the "touch" key's
   sim::State init;                       // the reference's init_qpos / init_qvel
   int camera = -1;                       // id of the free-view camera "view"
 };
@@ -121,6 +122,7 @@ class MimoEnv : public Env {
   StepResult step(std::span<const double> action) override;
   const ObservationBuffers& observation() const override { return obs_; }
   const Info& info() const override { return info_; }
+  const ObservationLayout* layout(std::string_view key) const override;
 
   const SampleAssets& assets() const { return *assets_; }
   const SampleDefinition& definition() const { return assets_->definition; }
@@ -132,8 +134,9 @@ class MimoEnv : public Env {
   const senses::Touch* touch() const { return assets_->touch.get(); }
   int key_index(std::string_view key) const;
   int episode_steps() const { return steps_; }
-  bool success() const { return info_.is_success; }
-  bool failure() const { return info_.is_failure; }
+  // The task's flags of the last step (info "is_success", "is_failure").
+  bool success() const { return info_.flag(success_slot_); }
+  bool failure() const { return info_.flag(failure_slot_); }
   const Profile& profile() const { return profile_; }
   void clear_profile() { profile_ = {}; }
   // Renders the free view ("view" camera) at render_size^2 into rgb (row 0 at the top).
@@ -157,7 +160,7 @@ class MimoEnv : public Env {
   virtual void step_callback() {}
   virtual bool is_success() { return false; }
   virtual bool is_failure() { return false; }
-  virtual double compute_reward() = 0;  // after the flags of this step (info())
+  virtual double compute_reward() = 0;  // after the flags of this step (success(), failure())
   virtual void achieved_goal(std::span<double> out) { (void)out; }
   virtual void extra_observation(std::span<double> out) { (void)out; }  // extra_observation values
 
@@ -185,6 +188,7 @@ class MimoEnv : public Env {
       achieved_index_, desired_index_;
   std::vector<double> goal_;
   Info info_;
+  const int success_slot_, failure_slot_;
   Rng rng_;
   int steps_ = 0;
   Profile profile_;

@@ -133,7 +133,7 @@ class SelfBodyEnv final : public MimoEnv {
   bool is_success() override { return arm_touches(skin_[target_]); }
 
   double compute_reward() override {
-    if (info().is_success) return kTouchReward;
+    if (success()) return kTouchReward;
     if (feels(skin_[kTargets]) || feels(skin_[kTargets + 1])) {
       double v[3];
       mju_sub3(v, data()->xpos + 3 * fingers_, data()->xpos + 3 * skin_[target_]);

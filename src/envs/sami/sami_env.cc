@@ -8,7 +8,8 @@ SamiEnvAdapter::SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env)
     : env_(std::move(env)),
       space_(env_->spec().observation_space()),
       action_space_(env_->spec().action_space()),
-      buffers_(space_) {}
+      buffers_(space_),
+      success_slot_(info_.declare("is_success", InfoType::kBool)) {}
 
 void SamiEnvAdapter::copy_observation() {
   // Key i of the family's flat observation goes to buffer i in its declared dtype.
@@ -23,7 +24,7 @@ void SamiEnvAdapter::copy_observation() {
     }
   }
   info_.steps = env_->info().steps;
-  info_.is_success = env_->info().is_success;
+  info_.set(success_slot_, env_->info().is_success);
 }
 
 void SamiEnvAdapter::reset(std::optional<std::uint64_t> seed) {

@@ -28,6 +28,7 @@ class SamiEnvAdapter final : public Env {
   Box action_space_;
   ObservationBuffers buffers_;
   Info info_;
+  int success_slot_ = -1;  // info "is_success"
 };
 
 // A SaMI env by name and split (or task-set YAML file) behind the Env interface.

@@ -16,20 +16,22 @@ TmaEnvAdapter::TmaEnvAdapter(const tma::TmaOptions& options, std::shared_ptr<con
       observation_space_(observation_space_of(env_)),
       action_space_(Box::uniform({env_.action_size()}, DType::kFloat64, -1.0, 1.0)),
       buffers_(observation_space_) {
+  success_slot_ = info_.declare("is_success", InfoType::kBool);
+  failure_slot_ = info_.declare("is_failure", InfoType::kBool);
   copy_observation();
 }
 
 void TmaEnvAdapter::reset(std::optional<std::uint64_t> seed) {
   env_.reset(seed);
-  info_ = Info{};
+  info_.clear();
   copy_observation();
 }
 
 StepResult TmaEnvAdapter::step(std::span<const double> action) {
   const tma::TmaStep r = env_.step(action);
   info_.steps = env_.episode_steps() - 1;
-  info_.is_success = r.success;
-  info_.is_failure = r.terminated && r.reward == -100;
+  info_.set(success_slot_, r.success);
+  info_.set(failure_slot_, r.terminated && r.reward == -100);
   copy_observation();
   return StepResult{.reward = r.reward, .terminated = r.terminated, .truncated = r.truncated};
 }

@@ -29,6 +29,7 @@ class TmaEnvAdapter : public Env {
   Box action_space_;
   ObservationBuffers buffers_;
   Info info_;
+  int success_slot_ = -1, failure_slot_ = -1;  // info "is_success", "is_failure"
 };
 
 }  // namespace cradle::envs

@@ -7,8 +7,6 @@
 #include <string>
 
 #include "core/error.h"
-#include "envs/babybench.h"
-#include "envs/self_touch.h"
 
 namespace cradle::learn::intrinsic {
 namespace {
@@ -41,26 +39,20 @@ void BodyPartNovelty::bind(const VecEnv& env) {
   const int n = env.num_envs();
   seen_.assign(n, {0, 0});
   starts_.assign(n, true);
-  hand_of_geom_.clear();
-  is_mimo_.clear();
-  const auto* baby = n > 0 ? dynamic_cast<const envs::BabyBenchEnv*>(&env.env(0)) : nullptr;
-  if (baby && options_.onset_weight > 0) {
-    const mjModel* m = baby->model();
-    const envs::SelfTouch rule(m);  // the behaviour's own geom tables
-    hand_of_geom_.assign(m->ngeom, -1);
-    is_mimo_.assign(m->ngeom, 0);
-    for (int g : rule.mimo_geoms()) is_mimo_[g] = 1;
-    for (int h = 0; h < 2; ++h) {
-      for (int g : rule.hand_geoms(h)) hand_of_geom_[g] = h;
-    }
-    in_contact_.assign(2 * n, std::vector<std::uint8_t>(m->ngeom, 0));
-    now_.assign(2, std::vector<std::uint8_t>(m->ngeom, 0));
+  const char* touches[2] = {"right_hand_touches", "left_hand_touches"};
+  const char* contacts[2] = {"right_hand_contacts", "left_hand_contacts"};
+  for (int h = 0; h < 2; ++h) {
+    touches_slot_[h] = n > 0 ? env.info(0).find(touches[h]) : -1;
+    contacts_slot_[h] = n > 0 ? env.info(0).find(contacts[h]) : -1;
   }
+  onsets_ = options_.onset_weight > 0 && contacts_slot_[0] >= 0 && contacts_slot_[1] >= 0;
+  in_contact_.assign(onsets_ ? 2 * n : 0, {});
+  now_.assign(onsets_ ? 2 : 0, {});
 }
 
 void BodyPartNovelty::start_episode(int i) {
   seen_[i] = {0, 0};
-  if (hand_of_geom_.empty()) return;
+  if (!onsets_) return;
   for (int h = 0; h < 2; ++h) {
     std::fill(in_contact_[2 * i + h].begin(), in_contact_[2 * i + h].end(), 0);
   }
@@ -71,32 +63,29 @@ void BodyPartNovelty::reset(const VecEnv& env) {
   events_.clear();
   for (int i = 0; i < env.num_envs(); ++i) {
     start_episode(i);
-    if (!hand_of_geom_.empty()) collect_onsets(env, i);
+    if (onsets_) collect_onsets(env, i);
   }
   events_.clear();  // contacts present at the start are no onsets
   starts_.assign(env.num_envs(), false);
 }
 
 void BodyPartNovelty::collect_onsets(const VecEnv& env, int i) {
-  const auto& baby = dynamic_cast<const envs::BabyBenchEnv&>(env.env(i));
-  const mjData* d = baby.data();
-  for (auto& now : now_) std::fill(now.begin(), now.end(), 0);
-  // The self-touch rule: a hand geom against a MIMo geom that is not part of the same hand.
-  auto touch = [&](int hand_geom, int other) {
-    const int hand = hand_of_geom_[hand_geom];
-    if (hand < 0 || !is_mimo_[other] || hand_of_geom_[other] == hand) return;
-    now_[hand][other] = 1;
-  };
-  for (int c = 0; c < d->ncon; ++c) {
-    touch(d->contact[c].geom1, d->contact[c].geom2);
-    touch(d->contact[c].geom2, d->contact[c].geom1);
-  }
+  const envs::Info& info = env.info(i);
   for (int h = 0; h < 2; ++h) {
     std::vector<std::uint8_t>& before = in_contact_[2 * i + h];
-    for (size_t g = 0; g < before.size(); ++g) {
-      if (now_[h][g] && !before[g]) events_.push_back({h, static_cast<int>(g), true});
+    std::vector<std::uint8_t>& now = now_[h];
+    std::fill(now.begin(), now.end(), 0);
+    for (int g : info.list(contacts_slot_[h])) {
+      if (g >= static_cast<int>(now.size())) now.resize(g + 1, 0);
+      now[g] = 1;
     }
-    before.swap(now_[h]);
+    // Both sized to the largest geom id seen (absent ids are not in contact).
+    if (before.size() < now.size()) before.resize(now.size(), 0);
+    if (now.size() < before.size()) now.resize(before.size(), 0);
+    for (size_t g = 0; g < before.size(); ++g) {
+      if (now[g] && !before[g]) events_.push_back({h, static_cast<int>(g), true});
+    }
+    before.swap(now);
   }
 }
 
@@ -108,13 +97,14 @@ void BodyPartNovelty::compute(const VecEnv& env, std::span<const double>,
   for (int i = 0; i < env.num_envs(); ++i) {
     const size_t before = events_.size();
     if (starts_[i]) start_episode(i);
-    if (!hand_of_geom_.empty()) {
+    if (onsets_) {
       collect_onsets(env, i);
       if (starts_[i]) events_.resize(before);  // a new episode's first contacts are no onsets
     }
     const envs::Info& info = env.info(i);
     for (int h = 0; h < 2; ++h) {
-      const std::vector<int>& list = h == 0 ? info.right_hand_touches : info.left_hand_touches;
+      if (touches_slot_[h] < 0) continue;
+      const std::span<const int> list = info.list(touches_slot_[h]);
       if (list.size() < seen_[i][h]) seen_[i][h] = 0;  // reset behind our back
       for (size_t k = seen_[i][h]; k < list.size(); ++k) events_.push_back({h, list[k], false});
       seen_[i][h] = list.size();

@@ -1,12 +1,13 @@
 // body_part_novelty: count-based novelty of self-touch, per hand and per touched MIMo geom.
 //
 // Events. In each step, env i produces
-//   first touches: the geom ids appended this step to info(i).right_hand_touches (hand 0) and
-//     info(i).left_hand_touches (hand 1), i.e. the geoms a hand touches for the first time in the
+//   first touches: the geom ids appended this step to the info lists "right_hand_touches" (hand 0)
+//     and "left_hand_touches" (hand 1), i.e. the geoms a hand touches for the first time in the
 //     episode (the env's self-touch behaviour decides what a touch is: any contact between a hand
 //     geom and another MIMo geom outside that hand);
-//   contact onsets (only when the env is a BabyBenchEnv): the (hand, geom) pairs in contact in
-//     this step's mjData but not in the previous step's, by the same contact rule.
+//   contact onsets (when the env publishes "right_hand_contacts" and "left_hand_contacts", the
+//     geoms each hand touches in this step by the same rule): the (hand, geom) pairs in contact
+//     in this step but not in the previous one.
 // Counts over the whole training run, shared by every env of the vector:
 //   n(h, g): first touches of geom g by hand h so far;   m(h, g): contact onsets so far;
 //   D_h: the number of geoms with n(h, g) > 0 (distinct geoms hand h has ever touched).
@@ -22,7 +23,7 @@
 // over episodes: the bonus tracks the metric (the union of touched geoms over training) while
 // still paying, a little, for re-finding known geoms in every episode.
 //
-// Reads only Info (and, for onsets, the env's own contacts); its cost is a scan of d->contact.
+// Reads only Info; its cost is a scan of this step's contact lists.
 #pragma once
 
 #include <array>
@@ -81,15 +82,14 @@ class BodyPartNovelty final : public IntrinsicReward {
   std::array<int, 2> distinct_{0, 0};
 
   // Per env: entries of the Info touch lists already rewarded, and (for onsets) which geoms each
-  // hand touched in the previous step (indexed env * 2 + hand, then geom id).
+  // hand touched in the previous step (indexed env * 2 + hand, then geom id; grown on demand).
   std::vector<std::array<size_t, 2>> seen_;
   std::vector<std::vector<std::uint8_t>> in_contact_, now_;
   detail::EpisodeStarts starts_;
 
-  // Contact rule of a BabyBenchEnv's model (empty: onsets off): hand of each geom (-1 none) and
-  // whether a geom is MIMo's.
-  std::vector<int> hand_of_geom_;
-  std::vector<std::uint8_t> is_mimo_;
+  // Info slots of the env's touch and contact lists per hand (-1: not published).
+  std::array<int, 2> touches_slot_{-1, -1}, contacts_slot_{-1, -1};
+  bool onsets_ = false;        // the env publishes its contacts and onset_weight > 0
   std::vector<Event> events_;  // scratch: this step's events
   std::vector<int> event_env_;
 };

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "envs/babybench.h"
-
 namespace cradle::learn::intrinsic {
 
 Features::Features(const VecEnv& env, Options options) : options_(options) {
@@ -14,16 +12,19 @@ Features::Features(const VecEnv& env, Options options) : options_(options) {
     if (key == "touch") {
       if (!options_.touch) continue;
       parts_.push_back({Kind::kTouch, k, box.dtype});
-      const auto* baby =
-          env.num_envs() > 0 ? dynamic_cast<const envs::BabyBenchEnv*>(&env.env(0)) : nullptr;
-      if (baby && baby->touch()) {
-        const senses::Touch& touch = *baby->touch();
-        const int per = touch.values_per_sensor();
-        for (int body : touch.bodies()) {
-          const int count = touch.sensors_on_body(body);
-          if (count == 0) continue;
-          const int first = touch.first_sensor(body);
-          touch_ranges_.push_back({first * per, (first + count) * per});
+      // The skin's body of each sensor, when the env publishes it.
+      const envs::ObservationLayout* skin = env.num_envs() > 0 ? env.env(0).layout(key) : nullptr;
+      const std::vector<int>* body = nullptr;
+      if (skin) {
+        const auto it = skin->groups.find("body");
+        if (it != skin->groups.end()) body = &it->second;
+      }
+      if (body) {
+        // One group per run of sensors on the same body (a body's sensors are contiguous).
+        const int per = skin->values_per_item;
+        for (int s = 0; s < static_cast<int>(body->size()); ++s) {
+          if (s == 0 || (*body)[s] != (*body)[s - 1]) touch_ranges_.push_back({s * per, s * per});
+          touch_ranges_.back().second = (s + 1) * per;
         }
       } else {
         const int total = box.size();

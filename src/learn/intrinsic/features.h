@@ -3,8 +3,9 @@
 //
 // Features of one env's observation, in observation order:
 //   every float64 / float32 entry except "touch" (proprioception, vestibular): copied as is;
-//   "touch": pooled per sensing body (per contiguous chunk of touch_chunks equal parts when the env
-//     is no BabyBenchEnv): log(1 + sum of |value| over the body's entries);
+//   "touch": pooled per sensing body (the "body" grouping of the layout the env publishes for
+//     it; per contiguous chunk of touch_chunks equal parts when it publishes none):
+//     log(1 + sum of |value| over the body's entries);
 //   every uint8 image {H, W, 3}: grey (mean of R, G, B) / 255, averaged over an
 //     image_cells x image_cells grid of blocks.
 // A RunningNorm then standardises each feature: (x - mean) / sqrt(var + 1e-8), clipped to

@@ -1,4 +1,4 @@
-#include "learn/learner.h"
+#include "learn/registry.h"
 
 #include "core/error.h"
 #include "learn/a2c.h"

@@ -16,7 +16,7 @@
 #include "eval/evaluation.h"
 #include "learn/learner.h"
 
-namespace cradle::learn {
+namespace cradle::train {
 
 struct TrainOptions {
   // With resume: empty continues the checkpoint's algorithm, another name is refused.
@@ -44,7 +44,7 @@ struct TrainOptions {
   bool progress_bar = true;
   // Extra reward terms (e.g. Python callables), called after the named intrinsic rewards with
   // the same arguments; they may add to the rewards in place.
-  RewardHook reward_hook;
+  learn::RewardHook reward_hook;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
 };
@@ -64,4 +64,4 @@ TrainResult train(const Config& config, const TrainOptions& options);
 // The policy of a checkpoint, for `cradle evaluate --policy` (deterministic actions).
 eval::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint);
 
-}  // namespace cradle::learn
+}  // namespace cradle::train

@@ -1,4 +1,4 @@
-#include "learn/trainer.h"
+#include "train/trainer.h"
 
 #include <chrono>
 #include <cmath>
@@ -10,18 +10,22 @@
 #include "core/error.h"
 #include "core/jsonl.h"
 #include "envs/babybench.h"
+#include "eval/figures.h"
 #include "eval/log_check.h"
-#include "eval/plot.h"
 #include "eval/scores.h"
 #include "learn/hyperparams.h"
 #include "learn/intrinsic/reward.h"
+#include "learn/registry.h"
 #include "learn/run_files.h"
 #include "learn/vector_env.h"
+#include "train/babybench_vector.h"
 
-namespace cradle::learn {
+namespace cradle::train {
 namespace {
 
 namespace fs = std::filesystem;
+// The run drives a learner: checkpoints, run state, stats and intrinsic rewards are learn's.
+using namespace cradle::learn;
 using Clock = std::chrono::steady_clock;
 
 // Columns of logs/progress.csv, CleanRL's names.
@@ -66,10 +70,10 @@ std::string duration_text(double seconds) {
   return buf;
 }
 
-// Learning curves from progress.csv's rows.
+// Learning curves from progress.csv's rows (matplotlib).
 void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& dir) {
-  auto series = [&](int column, const char* label, int color) {
-    eval::Series s{.label = label, .color = eval::default_color(color)};
+  auto series = [&](int column, const char* label) {
+    eval::Series s{.label = label};
     for (const auto& r : rows) {
       if (!std::isnan(r[column])) {
         s.x.push_back(r[0]);
@@ -78,16 +82,18 @@ void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& d
     }
     return s;
   };
-  eval::write_png(eval::render_line_plot({.title = "Training: episodic return (env + intrinsic)",
-                                          .x_label = "env steps",
-                                          .y_label = "return",
-                                          .series = {series(3, "episodic return", 0)}}),
-                  dir / "learning_curve_return.png");
-  eval::write_png(eval::render_line_plot({.title = "Training: behaviour score per episode",
-                                          .x_label = "env steps",
-                                          .y_label = "score",
-                                          .series = {series(5, "behaviour score", 1)}}),
-                  dir / "learning_curve_score.png");
+  eval::Figures figures;
+  figures.add(eval::LinePlot{.title = "Training: episodic return (env + intrinsic)",
+                             .x_label = "env steps",
+                             .y_label = "return",
+                             .series = {series(3, "episodic return")}},
+              dir / "learning_curve_return.png");
+  figures.add(eval::LinePlot{.title = "Training: behaviour score per episode",
+                             .x_label = "env steps",
+                             .y_label = "score",
+                             .series = {series(5, "behaviour score")}},
+              dir / "learning_curve_score.png");
+  figures.draw(dir / "figures.json");
 }
 
 }  // namespace
@@ -127,9 +133,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                     options.seed, kept_episodes);
   std::vector<envs::BabyBenchEnv*> envs;
   for (int i = 0; i < vec->num_envs(); ++i) {
+    if (options.randomize_start) vec->env(i).set_reset_options({{"randomize_start", 1}});
+    // The family's own: a resumed run's first reset ends no episode of this run's log.
     envs.push_back(&dynamic_cast<envs::BabyBenchEnv&>(vec->env(i)));
-    if (options.randomize_start) envs.back()->set_randomize_start(true);
-    // A resumed run's first reset ends no episode of this run's log.
     if (options.resume) envs.back()->skip_next_record();
   }
   const std::shared_ptr<envs::TrainingLog> training_log = envs[0]->log();
@@ -152,8 +158,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (options.reward_hook) options.reward_hook(env, actions, rewards);
     for (int i = 0; i < env.num_envs(); ++i) {
       if (env.terminated()[i] || env.truncated()[i]) {
-        const envs::Info& info = env.info(i);
-        const double s = envs::episode_score(config.behavior, info, info.steps + 1);
+        const double s = env.env(i).score();
         if (!std::isnan(s)) {
           score_sum += s;
           ++score_count;
@@ -161,7 +166,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
       }
     }
   };
-  std::unique_ptr<Learner> learner = make_learner(algorithm, *vec, lo);
+  std::unique_ptr<Learner> learner = learn::make_learner(algorithm, *vec, lo);
   if (options.resume) {
     learner->load(latest);
     load_run_state(latest, reward.get());
@@ -307,15 +312,15 @@ eval::Policy load_policy(const Config& config, const std::filesystem::path& chec
   if (!fs::exists(checkpoint)) {
     throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
   }
-  const CheckpointInfo info = read_checkpoint_info(checkpoint);
+  const CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
   // A one-env vector of the config gives the learner its spaces; it is kept alive by the policy.
   std::shared_ptr<VecEnv> vec = make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
-  LearnerOptions lo{.hyperparameters = parse_hyperparameter_text(info.config)};
-  std::shared_ptr<Learner> learner = make_learner(info.algorithm, *vec, lo);
+  LearnerOptions lo{.hyperparameters = learn::parse_hyperparameter_text(info.config)};
+  std::shared_ptr<Learner> learner = learn::make_learner(info.algorithm, *vec, lo);
   learner->load(checkpoint);
   return [vec, learner](const envs::BabyBenchEnv& env, std::span<double> action) {
     learner->act(env.observation(), action, /*deterministic=*/true);
   };
 }
 
-}  // namespace cradle::learn
+}  // namespace cradle::train

@@ -1,0 +1,63 @@
+#include "train/babybench_vector.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+
+#include "core/error.h"
+#include "envs/babybench.h"
+
+namespace cradle::train {
+namespace {
+
+// Refuses a vector whose envs' MuJoCo data (stack and buffer, sized by the model's njmax and
+// nconmax) and eye images need more than 80 % of the physical memory: it would be killed or swap.
+void check_env_memory(const envs::BabyBenchAssets& assets, int num_envs) {
+  const mjModel* m = assets.model.get();
+  double per_env = static_cast<double>(m->nstack) * sizeof(mjtNum) + m->nbuffer;
+  if (assets.config.vision_active) {
+    per_env += 2.0 * 4 * assets.config.vision_resolution * assets.config.vision_resolution * 4;
+  }
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  const double limit = 0.8 * physical;
+  if (per_env * num_envs <= limit) return;
+  char message[256];
+  std::snprintf(message, sizeof message,
+                "%d envs need about %.1f GB (%.0f MB each), more than 80%% of this machine's "
+                "%.1f GB of memory; use at most %d envs",
+                num_envs, per_env * num_envs / 1e9, per_env / 1e6, physical / 1e9,
+                std::max(1, static_cast<int>(limit / per_env)));
+  throw UserError(message);
+}
+
+}  // namespace
+
+std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
+                                                              int threads, bool training,
+                                                              std::uint64_t seed,
+                                                              long continue_log) {
+  using learn::ThreadedVecEnv;
+  if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
+  // One compiled model for all; one training log shared by all (it is thread-safe).
+  const auto assets = envs::make_assets(config);
+  check_env_memory(*assets, num_envs);
+  const std::shared_ptr<envs::TrainingLog> log =
+      training ? envs::start_training(*assets, continue_log) : nullptr;
+  // The log takes each env's entries in env order after every step, whatever thread ran first.
+  if (log) log->set_slots(num_envs);
+  auto vec = std::make_unique<ThreadedVecEnv>(
+      num_envs,
+      [&](int i) {
+        auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
+        if (log) env->attach_log(log, i);
+        return env;
+      },
+      threads);
+  if (log) vec->set_after_step([log] { log->commit(); });
+  return vec;
+}
+
+}  // namespace cradle::train

@@ -1,0 +1,56 @@
+// What the tests share: the reference configs, fresh temp folders, shell commands and the `cradle`
+// CLI runner (header-only; CRADLE_SOURCE_DIR and CRADLE_BINARY come from CMake).
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "core/config.h"
+
+namespace cradle::test {
+
+// configs/<name> of the source tree, e.g. "config_selftouch.yml".
+inline std::filesystem::path config_path(const std::string& name) {
+  return std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / name;
+}
+inline Config reference_config(const std::string& name) { return load_config(config_path(name)); }
+
+// An empty folder <tmp>/cradle_<tag>_<pid>, removed first if a crashed run left it.
+inline std::filesystem::path fresh_dir(const std::string& tag) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("cradle_" + tag + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+struct RunResult {
+  int status = -1;  // exit status (-1: could not run)
+  std::string out;  // what it printed on stdout (and stderr when the command merges it)
+};
+
+// Runs a shell command.
+inline RunResult run(const std::string& command) {
+  RunResult r;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// Runs `cradle <args>` (stdout and stderr together), in `dir` when given.
+inline RunResult run_cradle(const std::string& args, const std::filesystem::path& dir = {}) {
+  std::string command = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
+  if (!dir.empty()) command = "cd '" + dir.string() + "' && " + command;
+  return run(command);
+}
+
+}  // namespace cradle::test
