@@ -1,0 +1,56 @@
+// Curriculum teachers (TeachMyAgent ACL methods): each proposes flat float task vectors inside a
+// box and learns from the return and success of the episode played on them. Env-agnostic by design.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "core/rng.h"
+
+namespace cradle::teach {
+
+using Task = std::vector<float>;
+
+// The interface every teacher implements (hooks named as in TeachMyAgent's AbstractTeacher).
+class Teacher {
+ public:
+  // Throws UserError when the bounds are empty, of different sizes, non-finite or min > max.
+  Teacher(std::vector<float> mins, std::vector<float> maxs, std::uint64_t seed);
+  virtual ~Teacher() = default;
+
+  // A task for the next training episode.
+  virtual Task sample_task() = 0;
+  // A task with no exploration noise (curriculum snapshots); by default a normal sample.
+  virtual Task non_exploratory_task_sampling() { return sample_task(); }
+  virtual bool is_non_exploratory_task_sampling_available() const { return true; }
+  // Only step-driven teachers (SPDL) use these two.
+  virtual void record_initial_state(const Task& /*task*/, const std::vector<float>& /*s0*/) {}
+  virtual void step_update(const std::vector<float>& /*s*/, const std::vector<float>& /*a*/,
+                           double /*r*/, const std::vector<float>& /*s_next*/, bool /*done*/) {}
+  // End of a training episode played on `task`.
+  virtual void episodic_update(const Task& task, double ret, bool success) = 0;
+  // Book-keeping as JSON (name, bounds, and the teacher's own records).
+  virtual nlohmann::json dump() const;
+  virtual const char* name() const = 0;
+
+  int dims() const { return static_cast<int>(mins_.size()); }
+  const std::vector<float>& mins() const { return mins_; }
+  const std::vector<float>& maxs() const { return maxs_; }
+
+ protected:
+  // Uniform in the whole box.
+  Task uniform_task();
+  // Clips every coordinate into the box.
+  void clip(Task& task) const;
+
+  std::vector<float> mins_, maxs_;
+  Rng rng_;
+};
+
+// Uniform sampling in the box, no state.
+std::unique_ptr<Teacher> make_random_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                             std::uint64_t seed);
+
+}  // namespace cradle::teach
