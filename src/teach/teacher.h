@@ -53,4 +53,18 @@ class Teacher {
 std::unique_ptr<Teacher> make_random_teacher(std::vector<float> mins, std::vector<float> maxs,
                                              std::uint64_t seed);
 
+// ADR (automatic domain randomisation): a box grown outward from one point where returns are high.
+struct AdrParams {
+  float step_size = 0.1f;            // bound move, in task units
+  double boundary_prob = 0.5;        // class default (the benchmark passes 0.7)
+  int queue_len = 10;                // returns per bound and dimension before a decision
+  double max_reward_thr = 180.0;     // expand when the queue mean is at least this
+  double min_reward_thr = 0.0;       // shrink when the queue mean is at most this
+  std::vector<float> initial_point;  // empty: a uniformly random point (low expert knowledge)
+};
+// Throws UserError on a bad parameter (non-positive step or queue, probability outside [0, 1],
+// thresholds in the wrong order, an initial point of the wrong size or outside the box).
+std::unique_ptr<Teacher> make_adr_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                          std::uint64_t seed, AdrParams params = {});
+
 }  // namespace cradle::teach
