@@ -67,4 +67,17 @@ struct AdrParams {
 std::unique_ptr<Teacher> make_adr_teacher(std::vector<float> mins, std::vector<float> maxs,
                                           std::uint64_t seed, AdrParams params = {});
 
+// RIAC: a tree of regions split where absolute learning progress differs; samples regions by ALP.
+struct RiacParams {
+  int max_region_size = 200;   // maxlen: a leaf holding more pairs is split (benchmark 150)
+  int alp_window = 0;          // 0: = max_region_size
+  int nb_split_attempts = 50;  // benchmark 75
+  double min_region_size = 0;  // minlen; 0: max_region_size / 20
+  double min_dims_range_ratio = 1.0 / 6.0;  // benchmark 0.1
+  double discard_ratio = 0.25;              // oldest share dropped when no split is valid
+};
+// Throws UserError on a bad parameter.
+std::unique_ptr<Teacher> make_riac_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                           std::uint64_t seed, RiacParams params = {});
+
 }  // namespace cradle::teach
