@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "core/rng.h"
@@ -79,5 +80,16 @@ struct RiacParams {
 // Throws UserError on a bad parameter.
 std::unique_ptr<Teacher> make_riac_teacher(std::vector<float> mins, std::vector<float> maxs,
                                            std::uint64_t seed, RiacParams params = {});
+
+// ALP-GMM: GMMs fitted on [task, absolute learning progress]; components sampled by mean ALP.
+struct AlpGmmParams {
+  int fit_rate = 250;  // benchmark 150; also the bootstrap length
+  std::vector<int> potential_ks = {2, 3, 4, 5, 6, 7, 8, 9, 10};  // benchmark 2..9
+  double random_task_ratio = 0.2;                                // benchmark 0.05
+  std::string criterion = "aic";                                 // or "bic"
+};
+// Throws UserError on a bad parameter.
+std::unique_ptr<Teacher> make_alp_gmm_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                              std::uint64_t seed, AlpGmmParams params = {});
 
 }  // namespace cradle::teach
