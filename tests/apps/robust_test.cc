@@ -89,14 +89,9 @@ TEST(Robust, BadHyperparametersAreRefusedUpFront) {
   const fs::path dir = temp_dir("hp");
   const std::string train = "train --config " + quick_config(dir) +
                             " --envs 1 --steps 64 --eval-episodes 0 --intrinsic '' --hp n_steps=64";
-  for (const char* hp :
-       {"learning_rate=-1", "learning_rate=nan", "learning_rate=inf", "gamma=2", "clip_range=-1",
-        "max_grad_norm=-1", "vf_coef=-1e9", "ent_coef=inf", "n_epochs=0", "batch_size=0",
-        "gae_lambda=1.5", "pi_layers=64,0", "n_steps=99999999999"}) {
+  // Through the binary for a few; learn_test's HyperparameterRanges covers every learner.
+  for (const char* hp : {"learning_rate=nan", "gamma=2", "batch_size=0"}) {
     expect_one_line_error(train + " " + std::string(hp));
-  }
-  for (const char* algo : {"a2c", "sac", "td3", "ddpg"}) {
-    expect_one_line_error(train + " learning_rate=0 --algo " + algo);
   }
   fs::remove_all(dir);
 }
@@ -124,9 +119,8 @@ TEST(Robust, BadTrainingLogLinesNameTheirLine) {
   const std::string config = quick_config(dir);
   fs::create_directories(dir / "run" / "logs");
   for (const char* bad :
-       {"42", "null", "[1,2,3]", "\"text\"", R"({"steps":"many"})", R"({"steps":-1})",
-        R"({"steps":10,"right_hand_touches":[100000]})",
-        R"({"steps":10,"right_hand_touches":[-3]})", R"({"steps":10,"left_hand_touches":"x"})"}) {
+       {"42", "[1,2,3]", R"({"steps":"many"})", R"({"steps":10,"right_hand_touches":[100000]})",
+        R"({"steps":10,"left_hand_touches":"x"})"}) {
     std::ofstream(dir / "run" / "logs" / "training.jsonl")
         << "{\"steps\":0,\"right_hand_touches\":[],\"left_hand_touches\":[]}\n"
         << bad << "\n";

@@ -10,8 +10,12 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
+#include "learn/learner.h"
+#include "test_tasks.h"
 
 namespace cradle::learn {
 namespace {
@@ -91,6 +95,43 @@ TEST(RunFiles, NonFiniteLossIsOneLineErrorNamingTheUpdate) {
     EXPECT_NE(message.find("step 384"), std::string::npos) << message;
     EXPECT_NE(message.find("value_loss"), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+// Every learner refuses out-of-range and non-finite hyperparameters with one line.
+TEST(HyperparameterRanges, EveryLearnerRefusesBadValues) {
+  auto env = testing::make_cartpoles(1, 30);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"learning_rate", "-1"}, {"learning_rate", "nan"}, {"learning_rate", "inf"},
+      {"learning_rate", "0"},  {"gamma", "2"},           {"gamma", "-0.1"},
+      {"batch_size", "0"},     {"pi_layers", "64,0"},    {"log_std_init", "1e9"}};
+  for (const char* algo : {"ppo", "a2c", "sac", "td3", "ddpg"}) {
+    for (const auto& [name, value] : bad) {
+      if (std::string(algo) == "a2c" && name == "batch_size") continue;  // A2C has none
+      try {
+        make_learner(algo, *env, {.hyperparameters = {{name, value}}});
+        ADD_FAILURE() << algo << " accepted " << name << "=" << value;
+      } catch (const UserError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+      }
+    }
+  }
+  for (const auto& [name, value] :
+       std::vector<std::pair<std::string, std::string>>{{"clip_range", "-1"},
+                                                        {"max_grad_norm", "-1"},
+                                                        {"vf_coef", "-1e9"},
+                                                        {"ent_coef", "inf"},
+                                                        {"gae_lambda", "1.5"},
+                                                        {"n_epochs", "0"},
+                                                        {"batch_size", "4096"}}) {
+    EXPECT_THROW(make_learner("ppo", *env, {.hyperparameters = {{name, value}}}), UserError)
+        << name << "=" << value;
+  }
+  try {
+    make_learner("ppo", *env, {.hyperparameters = {{"gamma", "2"}}});
+  } catch (const UserError& e) {
+    EXPECT_EQ(std::string(e.what()), "hyperparameter 'gamma' = 2: expected 0 <= gamma <= 1");
   }
 }
 
