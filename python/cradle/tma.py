@@ -88,7 +88,8 @@ class TmaEnv:
         return self._env.body_type
 
     def set_environment(self, **task):
-        """Sets the task of the next reset(). Stump Tracks: stump_height, obstacle_spacing.
+        """Sets the task of the next reset(). Stump Tracks: stump_height, obstacle_spacing, and
+        the optional stump_width=(mean, std), stump_rot=(mean, std) (radians), roughness.
         Parkour: input_vector (3 values), water_level, creepers_width, creepers_height,
         creepers_spacing, terrain_cppn_scale. None leaves a parameter at its default."""
         params = [(k, _task_values(k, v)) for k, v in task.items() if v is not None]

@@ -137,8 +137,9 @@ void register_sami(CLI::App& app) {
   bench->add_option("--steps", opts->steps, "Env steps per env")
       ->check(CLI::Range(100L, 100000000L));
   bench->callback([opts] {
+    const std::vector<sami::EnvId> ids = envs_named(opts->env);
     std::printf("%-20s %14s %14s %8s\n", "env", "env steps/s", "bare steps/s", "ratio");
-    for (sami::EnvId id : envs_named(opts->env)) {
+    for (sami::EnvId id : ids) {
       const sami::Throughput t = sami::measure_throughput(id, opts->steps);
       std::printf("%-20s %14.0f %14.0f %8.3f\n", std::string(sami::env_name(id)).c_str(),
                   t.env_steps_per_s, t.bare_steps_per_s, t.ratio);

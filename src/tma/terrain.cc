@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 
 namespace cradle::tma {
 namespace {
@@ -29,14 +30,14 @@ b2Body* edge(b2World& world, Tag& tag, b2Vec2 a, b2Vec2 b) {
   return body;
 }
 
-b2Body* polygon(b2World& world, Tag& tag, b2BodyType type, std::initializer_list<b2Vec2> points,
+b2Body* polygon(b2World& world, Tag& tag, b2BodyType type, std::span<const b2Vec2> points,
                 double density, double friction, bool sensor) {
   b2BodyDef def;
   def.type = type;
   def.userData.pointer = reinterpret_cast<uintptr_t>(&tag);
   b2Body* body = world.CreateBody(&def);
   b2PolygonShape shape;
-  shape.Set(std::data(points), static_cast<int>(points.size()));
+  shape.Set(points.data(), static_cast<int>(points.size()));
   b2FixtureDef fd;
   fd.shape = &shape;
   fd.density = static_cast<float>(density);
@@ -45,6 +46,12 @@ b2Body* polygon(b2World& world, Tag& tag, b2BodyType type, std::initializer_list
   if (!sensor) fd.filter.maskBits = 0xFFFF;
   body->CreateFixture(&fd);
   return body;
+}
+
+b2Body* polygon(b2World& world, Tag& tag, b2BodyType type, std::initializer_list<b2Vec2> points,
+                double density, double friction, bool sensor) {
+  return polygon(world, tag, type, std::span<const b2Vec2>(points.begin(), points.size()), density,
+                 friction, sensor);
 }
 
 }  // namespace
@@ -58,27 +65,55 @@ double normal(Rng& rng, double mean, double std) {
 void build_stump_tracks(b2World& world, const StumpTask& task, double startpad, Rng& rng,
                         TerrainTags& tags, Scene& scene) {
   scene = Scene{};
-  const double h = kTerrainHeight, w = kTerrainStep;
   const double spacing = std::max(0.01, task.obstacle_spacing);
   const double pad = startpad * kTerrainStep, end = kTerrainLength * kTerrainStep;
-  // Recorded points: the pad, then each stump's two sides (the reference also records a duplicate
+  // Recorded points: the pad, then each stump's left side at the ground height it stands on and its
+  // right side at the height after the gap's roughness step (the reference also records a duplicate
   // point at the first stump: a zero-length edge, skipped here). The chain ends at the last
   // recorded x, which for spacing ~6 is before the finish line, as in the reference.
   std::vector<double>& xs = scene.xs;
+  std::vector<double>& ys = scene.ground;
   xs = {0.0};
-  for (double x = pad; x < end; x += w + spacing) {
+  ys = {kTerrainHeight};
+  double y = kTerrainHeight, velocity = 0.0;
+  for (double x = pad, width = kTerrainStep; x < end; x += width + spacing) {
+    // Draws per stump: height, then width, then rotation (each only when its dimension is set).
     const double height = std::max(0.05, normal(rng, task.stump_height, 0.1)) * kTerrainStep;
-    scene.bodies.push_back(polygon(
-        world, tags.stump, b2_staticBody,
-        {at(x, h), at(x + w, h), at(x + w, h + height), at(x, h + height)}, 0.0, kFriction, false));
+    width = task.stump_width
+                ? kTerrainStep *
+                      std::max(0.05, normal(rng, (*task.stump_width)[0], (*task.stump_width)[1]))
+                : kTerrainStep;
+    // Corners relative to the bottom edge's middle, turned counter-clockwise by the drawn angle.
+    const double half = width / 2, ax = x + half;
+    const std::array<double, 4> dx{-half, half, half, -half}, dy{0, 0, height, height};
+    double c = 1, s = 0;
+    if (task.stump_rot) {
+      const double angle = std::clamp(normal(rng, (*task.stump_rot)[0], (*task.stump_rot)[1]), 0.0,
+                                      2 * std::numbers::pi);
+      c = std::cos(angle);
+      s = std::sin(angle);
+    }
+    std::array<b2Vec2, 4> poly;
+    for (int k = 0; k < 4; ++k) {
+      poly[k] = task.stump_rot ? at(ax + dx[k] * c - dy[k] * s, y + dx[k] * s + dy[k] * c)
+                               : at(k == 0 || k == 3 ? x : x + width, y + dy[k]);
+    }
+    scene.bodies.push_back(polygon(world, tags.stump, b2_staticBody, poly, 0.0, kFriction, false));
     xs.push_back(x);
-    xs.push_back(x + w);
+    ys.push_back(y);
+    // The gap: the ground's vertical velocity relaxes towards TERRAIN_HEIGHT, plus roughness noise
+    // (no draw at roughness 0, so the default stream stays the benchmark's).
+    velocity = 0.8 * velocity + 0.01 * ((kTerrainHeight > y) - (kTerrainHeight < y));
+    if (task.roughness > 0) velocity += rng.uniform(-task.roughness, task.roughness) / kScale;
+    y += velocity;
+    xs.push_back(x + width);
+    ys.push_back(y);
   }
-  scene.ground.assign(xs.size(), h);
   for (size_t i = 0; i + 1 < xs.size(); ++i) {
-    edge(world, tags.ground, at(xs[i], h), at(xs[i + 1], h));
-    scene.fills.push_back(Polygon{{at(xs[i], h), at(xs[i + 1], h), at(xs[i + 1], 0), at(xs[i], 0)},
-                                  Rgb{0.4f, 0.6f, 0.3f}});
+    edge(world, tags.ground, at(xs[i], ys[i]), at(xs[i + 1], ys[i + 1]));
+    scene.fills.push_back(
+        Polygon{{at(xs[i], ys[i]), at(xs[i + 1], ys[i + 1]), at(xs[i + 1], 0), at(xs[i], 0)},
+                Rgb{0.4f, 0.6f, 0.3f}});
   }
 }
 

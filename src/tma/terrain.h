@@ -16,10 +16,15 @@
 namespace cradle::tma {
 
 // Stump Tracks task: stump heights ~ N(stump_height, 0.1) in TERRAIN_STEP units (floored at 0.05),
-// `obstacle_spacing` world units between stumps (floored at 0.01).
+// `obstacle_spacing` world units between stumps (floored at 0.01). Optional dimensions (unused by
+// the benchmark): stump width = TERRAIN_STEP * max(0.05, N(mean, std)); stump rotation (radians,
+// counter-clockwise about the bottom edge's middle) = clip(N(mean, std), 0, 2 pi); roughness r adds
+// uniform(-r, r) / 30 to the ground's vertical velocity at every gap.
 struct StumpTask {
   double stump_height = 0.0;
   double obstacle_spacing = 8.0;
+  std::optional<std::array<double, 2>> stump_width, stump_rot;  // (mean, std)
+  double roughness = 0.0;
 };
 
 // Parkour task (the 8-D task vector of the benchmark).

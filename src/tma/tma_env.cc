@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "core/error.h"
@@ -28,6 +29,16 @@ double single(const TaskParam& p, double lo, double hi) {
                     std::to_string(p.second.size()) + ")");
   }
   return checked(p.first, p.second[0], lo, hi);
+}
+
+// A (mean, std) pair: the mean within [lo, hi], the std within [0, std_hi].
+std::array<double, 2> pair(const TaskParam& p, double lo, double hi, double std_hi) {
+  if (p.second.size() != 2) {
+    throw UserError("task parameter " + p.first + " takes 2 values, mean and std (got " +
+                    std::to_string(p.second.size()) + ")");
+  }
+  return {checked(p.first + " mean", p.second[0], lo, hi),
+          checked(p.first + " std", p.second[1], 0, std_hi)};
 }
 
 }  // namespace
@@ -87,6 +98,15 @@ TmaEnv::~TmaEnv() {
 void TmaEnv::set_stump_task(const StumpTask& task) {
   checked("stump_height", task.stump_height, -3, 9);
   checked("obstacle_spacing", task.obstacle_spacing, 0, 10);
+  if (task.stump_width) {
+    checked("stump_width mean", (*task.stump_width)[0], 0, 10);
+    checked("stump_width std", (*task.stump_width)[1], 0, 10);
+  }
+  if (task.stump_rot) {
+    checked("stump_rot mean", (*task.stump_rot)[0], 0, 2 * std::numbers::pi);
+    checked("stump_rot std", (*task.stump_rot)[1], 0, 2 * std::numbers::pi);
+  }
+  checked("roughness", task.roughness, 0, 10);
   stump_task_ = task;
 }
 
@@ -113,9 +133,16 @@ void TmaEnv::set_environment(const std::vector<TaskParam>& params) {
         task.stump_height = single(p, -3, 9);
       } else if (p.first == "obstacle_spacing") {
         task.obstacle_spacing = single(p, 0, 10);
+      } else if (p.first == "stump_width") {
+        task.stump_width = pair(p, 0, 10, 10);
+      } else if (p.first == "stump_rot") {
+        task.stump_rot = pair(p, 0, 2 * std::numbers::pi, 2 * std::numbers::pi);
+      } else if (p.first == "roughness") {
+        task.roughness = single(p, 0, 10);
       } else {
         throw UserError("unknown Stump Tracks task parameter '" + p.first +
-                        "' (expected stump_height or obstacle_spacing)");
+                        "' (expected stump_height, obstacle_spacing, stump_width, stump_rot or "
+                        "roughness)");
       }
     }
     set_stump_task(task);

@@ -112,3 +112,24 @@ def test_bad_inputs_are_value_errors():
     env.reset(seed=0)
     with pytest.raises(ValueError, match="expected 4"):
         env.step(np.zeros(5))
+
+
+def test_stump_tracks_optional_dimensions():
+    """Roughness 0 keeps the ground flat, roughness > 0 makes it uneven; width and rotation are
+    (mean, std) pairs; same seed and task give the same terrain."""
+    env = tma.make(tma.STUMP_TRACKS, agent_body_type="old_classic_bipedal")
+    env.set_environment(stump_height=1.0, obstacle_spacing=1.0, roughness=0)
+    env.reset(seed=2)
+    assert np.all(np.asarray(env.terrain()[1]) == TERRAIN_HEIGHT)
+    task = dict(stump_height=1.0, obstacle_spacing=1.0, stump_width=[1.5, 0.2],
+                stump_rot=np.array([0.3, 0.1]), roughness=3.0)
+    env.set_environment(**task)
+    env.reset(seed=2)
+    xs, ground = np.asarray(env.terrain()[0]), np.asarray(env.terrain()[1])
+    assert np.ptp(ground) > 0.05
+    env.reset(seed=2)
+    np.testing.assert_array_equal(np.asarray(env.terrain()[1]), ground)
+    with pytest.raises(ValueError, match="stump_width takes 2 values"):
+        env.set_environment(stump_width=1.0)
+    with pytest.raises(ValueError, match="roughness"):
+        env.set_environment(roughness=float("nan"))

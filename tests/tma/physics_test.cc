@@ -178,3 +178,36 @@ TEST(TmaTerrain, ParkourTerrainShape) {
 
 }  // namespace
 }  // namespace cradle::tma
+
+namespace cradle::tma {
+namespace {
+
+// Movable creepers: chains of dynamic 1-unit segments jointed to the ceiling edge; a climber
+// still starts hanging and holds.
+TEST(TmaClimbing, MovableCreepersAreDynamicChains) {
+  TmaEnv env(TmaOptions{
+      .env = EnvId::kParkour, .body = "climbing_profile_chimpanzee", .movable_creepers = true});
+  env.set_environment({{"input_vector", {0.0, 0.0, 0.0}},
+                       {"water_level", {0.0}},
+                       {"creepers_width", {0.25}},
+                       {"creepers_height", {2.5}},
+                       {"creepers_spacing", {3.0}}});
+  env.reset(4);
+  int segments = 0;
+  for (const b2Body* b : env.scene().bodies) {
+    if (tag_of(b)->type != ObjectType::kCreeper) continue;
+    EXPECT_EQ(b->GetType(), b2_dynamicBody);
+    EXPECT_NE(b->GetJointList(), nullptr);
+    ++segments;
+  }
+  EXPECT_GT(segments, 0);
+  EXPECT_EQ(segments % 3, 0);  // ceil(2.5 +- noise) = 3 segments per creeper (noise sd 0.1)
+  std::vector<double> hold(12, 0.0);
+  hold[10] = hold[11] = 1.0;
+  const double y0 = env.agent().head->GetPosition().y;
+  for (int t = 0; t < 50; ++t) env.step(hold);
+  EXPECT_NEAR(env.agent().head->GetPosition().y, y0, 0.5);
+}
+
+}  // namespace
+}  // namespace cradle::tma
