@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "learn/learner.h"
+#include "learn/registry.h"
 #include "test_tasks.h"
 
 namespace cradle::learn {
