@@ -130,11 +130,10 @@ void build_amphibious_bipedal(Agent& agent, b2World& world, double x0, double y0
                                .amphibian_colors = true});
 }
 
-void build_old_big_quadru(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
+// The hull both big quadrupeds share (they differ only in how their legs hang from it).
+b2Body* build_quadru_hull(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
   agent.torque = 300;
   agent.torque_penalty = 3.5e-4 / 2;
-  const double leg_down = -8 / kScale, leg_w = 10 / kScale, leg_h = 51 / kScale;
-  const double half_bottom = 96 / 2 / kScale;
   const b2PolygonShape hull_shape =
       build::pixel_polygon({{-46, 13}, {6, 13}, {50, 5}, {50, -12}, {-46, -12}});
   b2Body* hull =
@@ -142,6 +141,13 @@ void build_old_big_quadru(Agent& agent, b2World& world, double x0, double y0, bo
                   true, critical_hull, kHull1, kHull2);
   agent.head = hull;
   agent.pushed.push_back(hull);
+  return hull;
+}
+
+void build_old_big_quadru(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
+  b2Body* hull = build_quadru_hull(agent, world, x0, y0, critical_hull);
+  const double leg_down = -8 / kScale, leg_w = 10 / kScale, leg_h = 51 / kScale;
+  const double half_bottom = 96 / 2 / kScale;
   const b2PolygonShape leg_shape = build::box(leg_w / 2, leg_h / 2);
   const b2PolygonShape lower_shape = build::box(0.8 * leg_w / 2, leg_h / 2);
   // The local anchor x is used raw while the spawn x is np.interp'ed (and clamped) onto the hull.
@@ -301,17 +307,9 @@ void build_profile_chimpanzee(Agent& agent, b2World& world, double x0, double y0
 }
 
 void build_big_quadru(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
-  agent.torque = 300;
-  agent.torque_penalty = 3.5e-4 / 2;
+  b2Body* hull = build_quadru_hull(agent, world, x0, y0, critical_hull);
   const double leg_down = 3 / kScale, leg_w = 10 / kScale, leg_h = 51 / kScale;
   const double half_bottom = 96 / 2 / kScale;
-  const b2PolygonShape hull_shape =
-      build::pixel_polygon({{-46, 13}, {6, 13}, {50, 5}, {50, -12}, {-46, -12}});
-  b2Body* hull =
-      build::part(agent, world, at(x0, y0), 0, hull_shape, Fixture{.density = 5.0, .friction = 0.1},
-                  true, critical_hull, kHull1, kHull2);
-  agent.head = hull;
-  agent.pushed.push_back(hull);
   const b2PolygonShape leg_shape = build::box(leg_w / 2, leg_h / 2);
   const b2PolygonShape lower_shape = build::box(0.8 * leg_w / 2, leg_h / 2);
   // Straight legs hanging from two points of the hull, world anchors.
