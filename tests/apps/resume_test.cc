@@ -16,35 +16,21 @@
 #include <thread>
 #include <vector>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using CliRun = cradle::test::RunResult;
 
-CliRun run_shell(const std::string& command) {
-  CliRun r;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
-}
+CliRun run_shell(const std::string& command) { return cradle::test::run(command + " 2>&1"); }
 
 CliRun cradle(const std::string& args) {
   return run_shell(std::string(CRADLE_BINARY) + " " + args);
 }
 
-fs::path temp_dir(const std::string& tag) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("cradle_resume_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path temp_dir(const std::string& tag) { return cradle::test::fresh_dir("resume_" + tag); }
 
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
