@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/error.h"
 
@@ -220,6 +221,23 @@ void motor(Agent& agent, b2RevoluteJoint* joint, double speed, const b2Body* con
                                .speed = speed,
                                .correction = correction,
                                .contact = contact ? tag_of(contact) : nullptr});
+}
+
+b2Body* chimpanzee_trunk(Agent& agent, b2World& world, double x0, double y0, const Fixture& fixture,
+                         Rgb c1, Rgb c2) {
+  const auto at = [](double x, double y) {
+    return b2Vec2(static_cast<float>(x), static_cast<float>(y));
+  };
+  const b2PolygonShape head_shape = pixel_polygon({{-5, 10}, {5, 10}, {5, -10}, {-5, -10}});
+  b2Body* head = part(agent, world, at(x0, y0 + 45 / kScale / 2 + 20 / kScale / 2 + 0.2), 0,
+                      head_shape, fixture, true, true, c1, c2);
+  agent.head = head;
+  agent.pushed.push_back(head);
+  const b2PolygonShape torso_shape = pixel_polygon({{-12, 25}, {12, 25}, {8, -20}, {-8, -20}});
+  b2Body* torso = part(agent, world, at(x0, y0), 0, torso_shape, fixture, true, true, c1, c2);
+  joint(world, head, torso, at(x0, y0 + 45 / kScale / 2), -0.1 * std::numbers::pi,
+        0.1 * std::numbers::pi, false);
+  return torso;
 }
 
 }  // namespace build

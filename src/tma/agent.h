@@ -103,6 +103,10 @@ b2RevoluteJoint* joint_local(b2World& world, b2Body* a, b2Body* b, b2Vec2 local_
                              double lower, double upper);
 void motor(Agent& agent, b2RevoluteJoint* joint, double speed, const b2Body* contact = nullptr,
            double correction = 0);
+// The chimpanzees' critical head (the reference object) on a passive neck over their torso, both
+// with `fixture`; returns the torso.
+b2Body* chimpanzee_trunk(Agent& agent, b2World& world, double x0, double y0, const Fixture& fixture,
+                         Rgb c1, Rgb c2);
 
 }  // namespace build
 

@@ -23,16 +23,7 @@ void build_climbing_chimpanzee(Agent& agent, b2World& world, double x0, double y
   const Fixture limb_fd{.mask = 0x1};
 
   // Head (reference object, critical) floats above the torso, held by a passive neck.
-  const b2PolygonShape head_shape = build::pixel_polygon({{-5, 10}, {5, 10}, {5, -10}, {-5, -10}});
-  b2Body* head = build::part(agent, world, at(x0, y0 + 45 / kScale / 2 + 20 / kScale / 2 + 0.2), 0,
-                             head_shape, body_fd, true, true, hull1, hull2);
-  agent.head = head;
-  agent.pushed.push_back(head);
-  const b2PolygonShape torso_shape =
-      build::pixel_polygon({{-12, 25}, {12, 25}, {8, -20}, {-8, -20}});
-  b2Body* torso =
-      build::part(agent, world, at(x0, y0), 0, torso_shape, body_fd, true, true, hull1, hull2);
-  build::joint(world, head, torso, at(x0, y0 + 45 / kScale / 2), -0.1 * kPi, 0.1 * kPi, false);
+  b2Body* torso = build::chimpanzee_trunk(agent, world, x0, y0, body_fd, hull1, hull2);
 
   const b2PolygonShape upper_shape = build::box(limb_w / 2, limb_h / 2);
   const b2PolygonShape lower_shape = build::box(0.8 * limb_w / 2, limb_h / 2);

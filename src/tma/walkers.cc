@@ -254,16 +254,7 @@ void build_profile_chimpanzee(Agent& agent, b2World& world, double x0, double y0
   const double limb_w = 8 / kScale, limb_h = 28 / kScale, hand_w = 4 / kScale, hand_h = 8 / kScale;
   const Fixture body_fd{.density = 5.0, .friction = 0.1, .mask = 0x1};
   const Fixture limb_fd{.mask = 0x1};
-  const b2PolygonShape head_shape = build::pixel_polygon({{-5, 10}, {5, 10}, {5, -10}, {-5, -10}});
-  b2Body* head = build::part(agent, world, at(x0, y0 + 45 / kScale / 2 + 20 / kScale / 2 + 0.2), 0,
-                             head_shape, body_fd, true, true, kHull1, kHull2);
-  agent.head = head;
-  agent.pushed.push_back(head);
-  const b2PolygonShape torso_shape =
-      build::pixel_polygon({{-12, 25}, {12, 25}, {8, -20}, {-8, -20}});
-  b2Body* torso =
-      build::part(agent, world, at(x0, y0), 0, torso_shape, body_fd, true, true, kHull1, kHull2);
-  build::joint(world, head, torso, at(x0, y0 + 45 / kScale / 2), -0.1 * kPi, 0.1 * kPi, false);
+  b2Body* torso = build::chimpanzee_trunk(agent, world, x0, y0, body_fd, kHull1, kHull2);
   const b2PolygonShape upper_shape = build::box(limb_w / 2, limb_h / 2);
   const b2PolygonShape lower_shape = build::box(0.8 * limb_w / 2, limb_h / 2);
   const b2PolygonShape hand_shape = build::box(hand_w / 2, hand_h / 2);
