@@ -28,6 +28,12 @@ class ParamReader {
       out = v->get<int>();
     }
   }
+  void get(const char* key, long& out) {
+    if (const auto* v = find(key)) {
+      if (!v->is_number_integer()) fail(key, "an integer", *v);
+      out = v->get<long>();
+    }
+  }
   void get(const char* key, double& out) {
     if (const auto* v = find(key)) {
       if (!v->is_number()) fail(key, "a number", *v);
@@ -70,6 +76,12 @@ class ParamReader {
       throw UserError(teacher_ + ": " + key + " = " + nlohmann::json(value).dump() +
                       " is not supported (" + why + "); expected " +
                       nlohmann::json(supported).dump());
+  }
+  // A key the reference has that we do not implement: only null (its default) is accepted.
+  void refuse(const char* key, const char* why) {
+    if (const auto* v = find(key))
+      throw UserError(teacher_ + ": " + key + " = " + v->dump() + " is not supported (" + why +
+                      "); expected null");
   }
   // Throws UserError naming the first key no get() asked for.
   void finish() const {
@@ -148,6 +160,38 @@ std::unique_ptr<Teacher> make_alp_gmm(const TeacherSetup& s, ParamReader& r) {
   return make_alp_gmm_teacher(s.mins, s.maxs, s.seed, std::move(p));
 }
 
+std::unique_ptr<Teacher> make_covar_gmm(const TeacherSetup& s, ParamReader& r) {
+  CovarGmmParams p;
+  r.get("fit_rate", p.fit_rate);
+  r.get("potential_ks", p.potential_ks);
+  r.get("random_task_ratio", p.random_task_ratio);
+  r.get("absolute_lp", p.absolute_lp);
+  r.finish();
+  if (s.expert_knowledge == ExpertKnowledge::high) p.initial_dist = s.initial_dist;
+  return make_covar_gmm_teacher(s.mins, s.maxs, s.seed, std::move(p));
+}
+
+std::unique_ptr<Teacher> make_self_paced(const TeacherSetup& s, ParamReader& r) {
+  SelfPacedParams p;
+  r.get("update_frequency", p.update_frequency);
+  r.get("update_offset", p.update_offset);
+  r.get("alpha_offset", p.alpha_offset);
+  r.get("zeta", p.zeta);
+  r.get("max_kl", p.max_kl);
+  r.get("use_avg_performance", p.use_avg_performance);
+  r.get("discount_factor", p.discount_factor);
+  r.refuse("std_lower_bound", "no std lower bound");
+  r.refuse("kl_threshold", "no std lower bound");
+  r.refuse("cg_parameters", "a direct natural-gradient solve");
+  r.finish();
+  // Only high expert knowledge gives the env's easy region and target (spec §1.3, fixed labels).
+  if (s.expert_knowledge == ExpertKnowledge::high) {
+    p.initial_dist = s.initial_dist;
+    p.target_dist = s.target_dist;
+  }
+  return make_self_paced_teacher(s.mins, s.maxs, s.seed, std::move(p));
+}
+
 std::unique_ptr<Teacher> not_yet(const TeacherSetup& s, ParamReader&) {
   throw UserError("teacher '" + s.name + "' is not implemented yet");
 }
@@ -167,9 +211,9 @@ const std::vector<Entry>& entries() {
        }},
       {"ADR", true, make_adr},
       {"ALP-GMM", false, make_alp_gmm},
-      {"Covar-GMM", false, not_yet},
+      {"Covar-GMM", false, make_covar_gmm},
       {"RIAC", false, make_riac},
-      {"Self-Paced", false, not_yet},
+      {"Self-Paced", false, make_self_paced},
       {"GoalGAN", true, not_yet},
       {"Setter-Solver", true, not_yet},
   };

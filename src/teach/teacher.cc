@@ -47,6 +47,18 @@ Task Teacher::gaussian_task(const DiagGaussian& dist) {
   return task;
 }
 
+DiagGaussian Teacher::dist_from_bounds(bool subspace) {
+  DiagGaussian g;
+  for (std::size_t i = 0; i < mins_.size(); ++i) {
+    const double range = static_cast<double>(maxs_[i]) - mins_[i];
+    const double mean = subspace ? rng_.uniform(mins_[i], maxs_[i]) : mins_[i] + range / 2;
+    const double std = subspace ? 0.1 * range : range / 4;
+    g.mean.push_back(static_cast<float>(mean));
+    g.variance.push_back(std == 0 ? 1e-6f : static_cast<float>(std * std));
+  }
+  return g;
+}
+
 void Teacher::check_dist(const DiagGaussian& dist, const std::string& what) const {
   // Sizes first, then values: the message names the first fault.
   if (dist.mean.size() != mins_.size() || dist.variance.size() != mins_.size())

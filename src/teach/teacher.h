@@ -60,6 +60,8 @@ class Teacher {
   void clip(Task& task) const;
   // A draw from a diagonal Gaussian, clipped to the box.
   Task gaussian_task(const DiagGaussian& dist);
+  // subspace: mean uniform in the box, std 10 % of each range; else the box centre, std range / 4.
+  DiagGaussian dist_from_bounds(bool subspace);
   // Throws UserError (naming `what`) unless dist has dims() finite means and variances >= 0.
   void check_dist(const DiagGaussian& dist, const std::string& what) const;
 
@@ -109,5 +111,37 @@ struct AlpGmmParams {
 // Throws UserError on a bad parameter.
 std::unique_ptr<Teacher> make_alp_gmm_teacher(std::vector<float> mins, std::vector<float> maxs,
                                               std::uint64_t seed, AlpGmmParams params = {});
+
+// Covar-GMM: GMMs fitted on [task, relative time, return]; components sampled by their positive
+// time-return covariance (learning progress).
+struct CovarGmmParams {
+  int fit_rate = 250;                                            // benchmark 150
+  std::vector<int> potential_ks = {2, 3, 4, 5, 6, 7, 8, 9, 10};  // benchmark 2..14
+  double random_task_ratio = 0.2;                                // benchmark 0.1
+  bool absolute_lp = false;                  // |covariance| instead of its positive part
+  std::optional<DiagGaussian> initial_dist;  // high expert knowledge: bootstrap tasks from it
+};
+// Throws UserError on a bad parameter.
+std::unique_ptr<Teacher> make_covar_gmm_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                                std::uint64_t seed, CovarGmmParams params = {});
+
+// Self-Paced Deep RL (SPDL): a Gaussian over tasks moved toward the target distribution as the
+// student's value of its tasks rises; step-driven (record_initial_state, step_update) and needs
+// set_value_estimator. Class defaults; the benchmark passes update_frequency 50000, alpha_offset
+// 10, zeta 0.25, use_avg_performance true.
+struct SelfPacedParams {
+  long update_frequency = 100000;    // env steps between updates (CLI default)
+  long update_offset = 200000;       // no update before this many steps
+  int alpha_offset = 0;              // iterations with alpha = 0
+  double zeta = 0.05;                // alpha's share of the performance
+  double max_kl = 0.1;               // trust region KL(old || new) (CLI default 0.8)
+  bool use_avg_performance = false;  // performance = mean discounted return, else mean value
+  double discount_factor = 0.99;     // the student's gamma
+  std::optional<DiagGaussian> initial_dist;  // none: a random sub-region (mean uniform, std 10 %)
+  std::optional<DiagGaussian> target_dist;   // none: centre of the box, std range / 4
+};
+// Throws UserError on a bad parameter or distribution.
+std::unique_ptr<Teacher> make_self_paced_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                                 std::uint64_t seed, SelfPacedParams params = {});
 
 }  // namespace cradle::teach
