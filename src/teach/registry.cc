@@ -192,8 +192,38 @@ std::unique_ptr<Teacher> make_self_paced(const TeacherSetup& s, ParamReader& r) 
   return make_self_paced_teacher(s.mins, s.maxs, s.seed, std::move(p));
 }
 
-std::unique_ptr<Teacher> not_yet(const TeacherSetup& s, ParamReader&) {
-  throw UserError("teacher '" + s.name + "' is not implemented yet");
+std::unique_ptr<Teacher> make_goal_gan(const TeacherSetup& s, ParamReader& r) {
+  GoalGanParams p;
+  r.get("state_noise_level", p.state_noise_level);
+  r.get("success_distance_threshold", p.success_distance_threshold);
+  r.get("update_size", p.update_size);
+  r.get("n_rollouts", p.n_rollouts);
+  r.get("goid_lb", p.goid_lb);
+  r.get("goid_ub", p.goid_ub);
+  r.get("p_old", p.p_old);
+  r.get("use_pretrained_samples", p.use_pretrained_samples);
+  r.get("pretrain_samples", p.pretrain_samples);
+  r.get("pretrain_iterations", p.pretrain_iterations);
+  r.get("train_iterations", p.train_iterations);
+  r.get("batch_size", p.batch_size);
+  r.get("lr", p.lr);
+  r.finish();
+  // High expert knowledge: always pretrained, on the env's easy region.
+  if (s.expert_knowledge == ExpertKnowledge::high) {
+    p.use_pretrained_samples = true;
+    p.initial_dist = s.initial_dist;
+  }
+  return make_goal_gan_teacher(s.mins, s.maxs, s.seed, std::move(p));
+}
+
+std::unique_ptr<Teacher> make_setter_solver(const TeacherSetup& s, ParamReader& r) {
+  SetterSolverParams p;
+  r.get("update_frequency", p.update_frequency);
+  r.get("setter_loss_noise_ub", p.setter_loss_noise_ub);
+  r.get("setter_hidden_size", p.setter_hidden_size);
+  r.get("lr", p.lr);
+  r.finish();
+  return make_setter_solver_teacher(s.mins, s.maxs, s.seed, p);
 }
 
 struct Entry {
@@ -214,8 +244,8 @@ const std::vector<Entry>& entries() {
       {"Covar-GMM", false, make_covar_gmm},
       {"RIAC", false, make_riac},
       {"Self-Paced", false, make_self_paced},
-      {"GoalGAN", true, not_yet},
-      {"Setter-Solver", true, not_yet},
+      {"GoalGAN", true, make_goal_gan},
+      {"Setter-Solver", true, make_setter_solver},
   };
   return all;
 }

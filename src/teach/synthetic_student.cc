@@ -50,6 +50,11 @@ std::pair<double, bool> SyntheticStudent::play(const Task& task) {
   return {ret, success};
 }
 
+double SyntheticStudent::expected_return(const Task& task) const {
+  const int cx = cell_of(task.at(0)), cy = cell_of(task.at(1));
+  return o_.max_return * competence_[static_cast<std::size_t>(cy) * o_.cells + cx];
+}
+
 double SyntheticStudent::mastered_percent() const {
   const auto n =
       std::count_if(competence_.begin(), competence_.end(), [&](double c) { return mastered(c); });
@@ -59,11 +64,21 @@ double SyntheticStudent::mastered_percent() const {
 double run_synthetic_curriculum(Teacher& teacher, int episodes, std::uint64_t seed,
                                 const SyntheticStudentOptions& options) {
   SyntheticStudent student(options, seed);
+  teacher.set_value_estimator([&student](const std::vector<std::vector<float>>& states) {
+    std::vector<float> v;
+    for (const auto& s : states) v.push_back(static_cast<float>(student.expected_return(s)));
+    return v;
+  });
+  // The teacher's hooks in the order a student calls them: reset, steps, end of episode.
+  const std::vector<float> no_action;
   for (int e = 0; e < episodes; ++e) {
     const Task task = teacher.sample_task();
+    teacher.record_initial_state(task, task);
     const auto [ret, success] = student.play(task);
+    teacher.step_update(task, no_action, ret, task, true);
     teacher.episodic_update(task, ret, success);
   }
+  teacher.set_value_estimator(nullptr);  // the student is about to go
   return student.mastered_percent();
 }
 

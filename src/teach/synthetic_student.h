@@ -28,6 +28,8 @@ class SyntheticStudent {
   SyntheticStudent(SyntheticStudentOptions options, std::uint64_t seed);
   // One episode on a task in [0, 1]^2 (clipped into the grid): the return and the success.
   std::pair<double, bool> play(const Task& task);
+  // The return a task would give now without noise (a perfect critic, for SPDL).
+  double expected_return(const Task& task) const;
   // Share of all cells mastered, in %.
   double mastered_percent() const;
 
@@ -42,7 +44,8 @@ class SyntheticStudent {
   std::vector<double> competence_;  // row-major, x index fastest
 };
 
-// Trains a fresh student with `teacher` for `episodes` episodes; the % of cells mastered.
+// Trains a fresh student with `teacher` for `episodes` one-step episodes (the task is the initial
+// state; the student's noiseless expected return is the value estimate); the % of cells mastered.
 double run_synthetic_curriculum(Teacher& teacher, int episodes, std::uint64_t seed,
                                 const SyntheticStudentOptions& options = {});
 

@@ -144,4 +144,37 @@ struct SelfPacedParams {
 std::unique_ptr<Teacher> make_self_paced_teacher(std::vector<float> mins, std::vector<float> maxs,
                                                  std::uint64_t seed, SelfPacedParams params = {});
 
+// GoalGAN: an LSGAN that learns to generate goals of intermediate difficulty (LibTorch). Class
+// defaults; the benchmark passes state_noise_level 0.1, p_old 0.1, use_pretrained_samples true.
+struct GoalGanParams {
+  double state_noise_level = 0.01;           // goal noise, share of each range
+  double success_distance_threshold = 0.01;  // share of the box diagonal
+  int update_size = 100;                     // labelled goals per GAN training
+  int n_rollouts = 2;                        // episodes per generated goal
+  double goid_lb = 0.25, goid_ub = 0.75;     // "goal of intermediate difficulty" success rates
+  double p_old = 0.2;                        // share of replayed successful goals
+  bool use_pretrained_samples = false;       // pretrain on initial_dist (or a random sub-region)
+  std::optional<DiagGaussian> initial_dist;
+  int pretrain_samples = 1000, pretrain_iterations = 500;  // the reference's fixed values
+  int train_iterations = 250, batch_size = 64;
+  double lr = 1e-3;  // RMSProp, both networks
+};
+// Throws UserError on a bad parameter.
+std::unique_ptr<Teacher> make_goal_gan_teacher(std::vector<float> mins, std::vector<float> maxs,
+                                               std::uint64_t seed, GoalGanParams params = {});
+
+// Setter-Solver: a conditional RealNVP setter proposes goals of a desired feasibility, a judge
+// learns feasibility from binary success (LibTorch). Class defaults; the benchmark passes
+// update_frequency 50, setter_loss_noise_ub 0.1, setter_hidden_size 64.
+struct SetterSolverParams {
+  int update_frequency = 100;          // episodes between training steps
+  double setter_loss_noise_ub = 0.01;  // validity jitter U(0, ub) (CLI default 0.05)
+  int setter_hidden_size = 128;        // width of the coupling nets
+  double lr = 3e-4;                    // Adam, setter and judge
+};
+// Throws UserError on a bad parameter.
+std::unique_ptr<Teacher> make_setter_solver_teacher(std::vector<float> mins,
+                                                    std::vector<float> maxs, std::uint64_t seed,
+                                                    SetterSolverParams params = {});
+
 }  // namespace cradle::teach
