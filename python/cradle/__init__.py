@@ -8,7 +8,7 @@
 See README.md, section "Python".
 """
 
-from . import sami, spaces
+from . import sami, spaces, teach
 from ._cradle import __version__
 from .env import (
     ENV_IDS,

@@ -154,4 +154,5 @@ PYBIND11_MODULE(_cradle, m) {
   cradle::python::bind_learn(m);
   cradle::python::bind_tma(m);
   cradle::python::bind_sami(m);
+  cradle::python::bind_teach(m);
 }
