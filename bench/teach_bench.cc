@@ -17,7 +17,9 @@ namespace {
 
 constexpr int kSeeds = 16;
 
-TeacherSetup bench_setup(const std::string& name, std::uint64_t seed) {
+// `name` may carry a variant after a slash: "Covar-GMM/rnd20" keeps the class default random ratio.
+TeacherSetup bench_setup(const std::string& label, std::uint64_t seed) {
+  const std::string name = label.substr(0, label.find('/'));
   TeacherSetup s{.name = name, .mins = {0.f, 0.f}, .maxs = {1.f, 1.f}, .seed = seed};
   s.expert_knowledge = ExpertKnowledge::low;
   if (name == "ADR") {
@@ -33,7 +35,7 @@ TeacherSetup bench_setup(const std::string& name, std::uint64_t seed) {
   } else if (name == "Covar-GMM") {
     s.params = {{"fit_rate", 150},
                 {"potential_ks", {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14}},
-                {"random_task_ratio", 0.1}};
+                {"random_task_ratio", label == "Covar-GMM/rnd20" ? 0.2 : 0.1}};
   } else if (name == "Self-Paced") {
     // One step per episode here, so the step schedule is in episodes (reference: 50k / 200k
     // steps of 2000-step episodes); the rest are the benchmark values.
@@ -90,6 +92,7 @@ CRADLE_TEACH_BENCH(ADR, "ADR");
 CRADLE_TEACH_BENCH(RIAC, "RIAC");
 CRADLE_TEACH_BENCH(ALP_GMM, "ALP-GMM");
 CRADLE_TEACH_BENCH(Covar_GMM, "Covar-GMM");
+CRADLE_TEACH_BENCH(Covar_GMM_rnd20, "Covar-GMM/rnd20");
 CRADLE_TEACH_BENCH(Self_Paced, "Self-Paced");
 CRADLE_TEACH_BENCH(GoalGAN, "GoalGAN");
 CRADLE_TEACH_BENCH(Setter_Solver, "Setter-Solver");
