@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,21 @@ TEST(Registry, HighExpertKnowledgeStartsFromTheEasyRegion) {
   gmm.expert_knowledge = ExpertKnowledge::high;
   gmm.initial_dist = DiagGaussian{{0.f}, {1.f}};
   EXPECT_NE(error_of([&] { make_teacher(gmm); }).find("initial_dist"), std::string::npos);
+}
+
+TEST(Registry, SelfPacedTakesTheEasyRegionOnlyAtHigh) {
+  auto s = setup_of("Self-Paced", ExpertKnowledge::high);
+  s.initial_dist = DiagGaussian{{0.5f, 1.f}, {0.01f, 0.01f}};
+  const auto mean_of = [](const TeacherSetup& setup) {
+    return make_teacher(setup)->dump().at("history").at(0).at("mean").get<std::vector<double>>();
+  };
+  EXPECT_NEAR(mean_of(s)[0], 0.5, 1e-6);
+  EXPECT_NEAR(mean_of(s)[1], 1.0, 1e-6);
+  // Below high: a random sub-region instead.
+  s.expert_knowledge = ExpertKnowledge::low;
+  EXPECT_GT(std::abs(mean_of(s)[1] - 1.0), 1e-3);
+  s.params = {{"std_lower_bound", 0.1}};
+  EXPECT_NE(error_of([&] { make_teacher(s); }).find("not supported"), std::string::npos);
 }
 
 TEST(Registry, ScalesAdrThresholdsWithTheReturns) {

@@ -2,6 +2,7 @@
 // put when it is zero, and needs the student's value estimator.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <vector>
 
@@ -55,6 +56,43 @@ TEST(SelfPaced, MovesTowardTheTargetAsTheValueRises) {
   const auto mean = history.back().at("mean").get<std::vector<double>>();
   EXPECT_NEAR(mean[0], 0.5, 0.05);
   EXPECT_NEAR(mean[1], 0.5, 0.05);
+}
+
+// KL(p || q) of two Gaussians given as mean and column-major covariance (as dumped).
+double kl(const nlohmann::json& p, const nlohmann::json& q) {
+  const auto pm = p.at("mean").get<std::vector<double>>(),
+             qm = q.at("mean").get<std::vector<double>>();
+  const auto pc = p.at("covariance").get<std::vector<double>>();
+  const auto qc = q.at("covariance").get<std::vector<double>>();
+  const int d = static_cast<int>(pm.size());
+  const Eigen::MatrixXd sp = Eigen::Map<const Eigen::MatrixXd>(pc.data(), d, d);
+  const Eigen::MatrixXd sq = Eigen::Map<const Eigen::MatrixXd>(qc.data(), d, d);
+  const Eigen::VectorXd dm = Eigen::Map<const Eigen::VectorXd>(qm.data(), d) -
+                             Eigen::Map<const Eigen::VectorXd>(pm.data(), d);
+  const Eigen::MatrixXd sq_inv = sq.inverse();
+  return 0.5 * ((sq_inv * sp).trace() + dm.dot(sq_inv * dm) - d +
+                std::log(sq.determinant() / sp.determinant()));
+}
+
+TEST(SelfPaced, EveryStepStaysInTheTrustRegion) {
+  SelfPacedParams p = params();
+  p.max_kl = 0.05;
+  auto t = make_self_paced_teacher({0.f, 0.f}, {1.f, 1.f}, 6, p);
+  t->set_value_estimator([](const std::vector<std::vector<float>>& s) {
+    std::vector<float> v;
+    for (const auto& x : s) v.push_back(10.f * x[0]);
+    return v;
+  });
+  play(*t, 500);  // 10 updates
+  const auto history = t->dump().at("history");
+  ASSERT_EQ(history.size(), 11u);
+  int moved = 0;
+  for (int i = 1; i < 11; ++i) {
+    const double step = kl(history[i - 1], history[i]);
+    EXPECT_LE(step, 1.5 * 0.05 + 1e-6) << i;
+    moved += step > 1e-4;
+  }
+  EXPECT_GE(moved, 5);
 }
 
 TEST(SelfPaced, StaysWhileTheValueIsZero) {
