@@ -75,10 +75,13 @@ envs::StepResult CurriculumEnv::step(std::span<const double> action) {
   }
   // The episode's outcome to the teacher.
   if (done && in_episode_) {
-    const bool success = std::isnan(options_.success_threshold)
-                             ? success_slot_ >= 0 && inner_->info().flag(success_slot_)
-                             : return_ > options_.success_threshold;
-    controller_->record_train_episode(task_.raw, return_, length_, success);
+    const bool success =
+        std::isnan(options_.success_threshold)
+            ? success_slot_ >= 0 && inner_->info().flag(success_slot_)
+            : (options_.use_score ? inner_->score() : return_) > options_.success_threshold;
+    const double outcome = options_.use_score ? inner_->score() : return_;
+    controller_->record_train_episode(task_.raw, std::isnan(outcome) ? 0.0 : outcome, length_,
+                                      success);
     in_episode_ = false;
   }
   teacher_seconds_ += since(start);

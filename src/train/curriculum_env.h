@@ -21,6 +21,9 @@ struct CurriculumOptions {
   double success_threshold = std::numeric_limits<double>::quiet_NaN();
   // Forward every step to the controller (its step count and SPDL's step_update).
   bool step_updates = true;
+  // The teacher hears the env's score() of the episode (e.g. BabyBench's behaviour score)
+  // instead of its return.
+  bool use_score = false;
 };
 
 class CurriculumEnv : public envs::Env {

@@ -46,7 +46,7 @@ CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string&
   if (!j.is_object()) throw UserError(source + ": expected a mapping with teacher and params");
   const std::string keys =
       "teacher, params, teacher_params, expert_knowledge, success_threshold, reward_bounds, "
-      "scale_reward";
+      "scale_reward, outcome";
   CurriculumSpec spec;
   auto wrong = [&](const std::string& key, const std::string& expected) {
     return UserError(source + ": " + key + " is " + j[key].dump() + "; expected " + expected);
@@ -82,6 +82,9 @@ CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string&
       }
       spec.reward_lb = value[0].get<double>();
       spec.reward_ub = value[1].get<double>();
+    } else if (key == "outcome") {
+      if (value != "return" && value != "score") throw wrong(key, "return or score");
+      spec.env_options.use_score = value == "score";
     } else if (key == "scale_reward") {
       if (!value.is_boolean()) throw wrong(key, "true or false");
       spec.scale_reward = value.get<bool>();

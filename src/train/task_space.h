@@ -9,6 +9,8 @@
 //                                          # env's info flag is_success
 //   reward_bounds: [-100, 100]             # optional: for scale_reward and ADR's thresholds
 //   scale_reward: false                    # optional
+//   outcome: return                        # optional: return (default) or score (the env's
+//                                          # score() of the episode, e.g. BabyBench's behaviour)
 #pragma once
 
 #include <cstdint>

@@ -52,6 +52,7 @@ class Corridor final : public envs::Env {
   }
   const envs::ObservationBuffers& observation() const override { return buffers_; }
   const envs::Info& info() const override { return info_; }
+  double score() const override { return 100.0 * steps_; }
 
   int resets = 0, options_set = 0;
   double gain_ = 0, next_length_ = 1, next_gain_ = 0;
@@ -149,6 +150,20 @@ TEST(CurriculumEnv, SuccessFromTheEnvFlagWithoutAThreshold) {
   ASSERT_EQ(t->heard.size(), 2u);
   EXPECT_TRUE(t->heard[0].success);   // 12 > 10
   EXPECT_FALSE(t->heard[1].success);  // 2
+}
+
+TEST(CurriculumEnv, TheTeacherHearsTheScoreWhenAsked) {
+  auto teacher = std::make_unique<ListTeacher>(std::vector<teach::Task>{{3.f, 1.f}});
+  ListTeacher* t = teacher.get();
+  CurriculumEnv env(std::make_unique<Corridor>(), controller_of(std::move(teacher)),
+                    {.success_threshold = 250, .use_score = true});
+  env.reset();
+  const std::vector<double> a = {0.0};
+  while (!env.step(a).truncated) {
+  }
+  ASSERT_EQ(t->heard.size(), 1u);
+  EXPECT_DOUBLE_EQ(t->heard[0].ret, 300);  // the score of 3 steps, not the return 3
+  EXPECT_TRUE(t->heard[0].success);
 }
 
 TEST(CurriculumEnv, CountsUnderAVectorEnvWithAutoreset) {

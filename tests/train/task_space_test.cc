@@ -24,6 +24,7 @@ expert_knowledge: low
 success_threshold: 12.5
 reward_bounds: [-10, 40]
 scale_reward: true
+outcome: score
 )",
                                                "test.yml");
   EXPECT_EQ(spec.teacher, "RIAC");
@@ -37,6 +38,7 @@ scale_reward: true
   EXPECT_DOUBLE_EQ(spec.env_options.success_threshold, 12.5);
   EXPECT_DOUBLE_EQ(spec.reward_lb, -10);
   EXPECT_TRUE(spec.scale_reward);
+  EXPECT_TRUE(spec.env_options.use_score);
   auto controller = make_controller(spec, 5);
   const teach::SampledTask t = controller->sample_train_task();
   ASSERT_EQ(t.real.size(), 6u);
@@ -54,6 +56,7 @@ TEST(TaskSpaceFile, BadFilesAreOneLineErrors) {
       "teacher: Random\nparams: {a: [0, 1]}\nreward_bounds: [1, 1]",
       "teacher: Random\nparams: {a: [0, 1]}\nsuccess_threshold: high",
       "teacher: [Random]\nparams: {a: [0, 1]}",
+      "teacher: Random\nparams: {a: [0, 1]}\noutcome: reward",
       "teacher: Random\nparams: {a: [0, 1",  // not YAML
   };
   for (const char* text : bad) {
