@@ -67,11 +67,12 @@ const std::string kSac =
 
 TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   const fs::path dir = fresh("cradle_tma_run_sac");
-  const std::string args = kSac +
-                           "--teacher ALP-GMM --teacher-param fit_rate=6 --teacher-param potential_ks=[2,3] "
-                           "--allow_expert_knowledge high --keep_periodical_task_samples 500 "
-                           "--out " +
-                           dir.string();
+  const std::string args =
+      kSac +
+      "--teacher ALP-GMM --teacher-param fit_rate=6 --teacher-param potential_ks=[2,3] "
+      "--allow_expert_knowledge high --keep_periodical_task_samples 500 "
+      "--out " +
+      dir.string();
   CliResult r = cradle(args + " --nb_env_steps 0.002");
   ASSERT_EQ(r.status, 0) << r.out;
 
