@@ -142,9 +142,19 @@ BabyBenchEnv::~BabyBenchEnv() {
 
 void BabyBenchEnv::set_reset_options(const ResetOptions& options) {
   for (const auto& [name, value] : options) {
+    // A curriculum's start posture: joints drawn within this share of their range around the
+    // settled pose (1: the whole range, as randomize_start).
+    if (name == "start_posture_range") {
+      if (!(value >= 0 && value <= 1)) {
+        throw UserError("reset option start_posture_range must be in [0, 1], not " +
+                        std::to_string(value));
+      }
+      start_posture_range_ = value;
+      continue;
+    }
     if (name != "randomize_start") {
       throw UserError("reset option '" + name +
-                      "' is not a BabyBench one (expected randomize_start)");
+                      "' is not a BabyBench one (expected randomize_start or start_posture_range)");
     }
     if (value != 0 && value != 1) {
       throw UserError("reset option randomize_start must be 0 or 1, not " + std::to_string(value));
@@ -199,11 +209,14 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
   if (seed) rng_.seed_with(*seed);
   sim_.reset();
   sim_.restore(assets_->settled);
-  if (randomize_start_) {
+  if (randomize_start_ || start_posture_range_ > 0) {
     const mjModel* m = model();
     mjData* d = sim_.data();
+    const double r = randomize_start_ ? 1.0 : start_posture_range_;
     for (int j : free_joints_) {
-      d->qpos[m->jnt_qposadr[j]] = rng_.uniform(m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
+      double& q = d->qpos[m->jnt_qposadr[j]];
+      const double lo = m->jnt_range[2 * j], hi = m->jnt_range[2 * j + 1];
+      q = r == 1.0 ? rng_.uniform(lo, hi) : rng_.uniform(q + r * (lo - q), q + r * (hi - q));
     }
     mj_forward(m, d);
   }

@@ -144,7 +144,8 @@ class BabyBenchEnv final : public Env {
   Rng rng_;
   std::vector<double> random_action_;
   bool randomize_start_ = false;
-  std::vector<int> free_joints_;  // robot:* joints no active joint equality holds
+  double start_posture_range_ = 0;  // [0, 1]: share of each joint's range drawn around the start
+  std::vector<int> free_joints_;    // robot:* joints no active joint equality holds
   int steps_ = 0;
   Profile profile_;
 };

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <thread>
 
+#include "core/error.h"
+
 namespace cradle::envs {
 namespace {
 
@@ -150,6 +152,32 @@ TEST(BabyBenchEnv, SeededRunsAreBitwiseIdentical) {
   // Reseeding reproduces the start exactly.
   b.reset(42);
   EXPECT_EQ(snapshot(a), snapshot(b));
+}
+
+// A curriculum's start posture: 0 is the plain start, larger shares move the start further, and
+// values outside [0, 1] are refused.
+TEST(BabyBenchEnv, StartPostureRangeScalesTheStartDraw) {
+  const auto shared = make_assets(reference("config_selftouch.yml"));
+  BabyBenchEnv env(shared);
+  auto start = [&](double range) {
+    env.set_reset_options({{"start_posture_range", range}});
+    env.reset(5);
+    return std::vector<double>(env.data()->qpos, env.data()->qpos + env.model()->nq);
+  };
+  auto distance = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double sum = 0;
+    for (size_t i = 0; i < a.size(); ++i) sum += std::abs(a[i] - b[i]);
+    return sum;
+  };
+  BabyBenchEnv plain(shared);
+  plain.reset(5);
+  const std::vector<double> q0(plain.data()->qpos, plain.data()->qpos + plain.model()->nq);
+  EXPECT_EQ(start(0), q0);
+  const double small = distance(start(0.1), q0), whole = distance(start(1), q0);
+  EXPECT_GT(small, 0);
+  EXPECT_GT(whole, 3 * small);
+  EXPECT_THROW(env.set_reset_options({{"start_posture_range", 1.5}}), UserError);
+  EXPECT_THROW(env.set_reset_options({{"start_posture", 0.5}}), UserError);
 }
 
 // Two envs stepped on two threads give the results of one thread: no shared mutable state.
