@@ -119,17 +119,21 @@ def load_run(path):
     launch = _read_json(os.path.join(path, "launch.json"))
     run_json = _read_json(os.path.join(path, "run.json"))
     args = launch.get("args", [])
-    run_args = run_json.get("args", run_json)
+    # run.json: the parsed values at the top, the command line's under "arguments".
+    given = run_json.get("arguments") if isinstance(run_json.get("arguments"), dict) else {}
+    aliases = {"allow_expert_knowledge": ("allow_expert_knowledge", "expert_knowledge")}
 
     def value(key, default):
         v = _arg(args, key)
-        if v is None and isinstance(run_args, dict):
-            v = run_args.get(key)
+        for name in aliases.get(key, (key,)):
+            for source in (run_json, given):
+                if v is None and isinstance(source.get(name), (str, int, float)):
+                    v = source.get(name)
         return str(v) if v is not None else default
 
     teacher = value("teacher", "unknown")
     name = os.path.basename(os.path.normpath(path))
-    seed = launch.get("seed", run_args.get("seed") if isinstance(run_args, dict) else None)
+    seed = launch.get("seed", run_json.get("seed", given.get("seed")))
     ek = value("allow_expert_knowledge", "none")
     ek = {"no": "none", "minimal": "low", "maximal": "high", "original": "high"}.get(ek, ek)
     return Run(

@@ -182,3 +182,18 @@ def test_notebooks_run_on_a_small_tree(name, tmp_path, monkeypatch):
             exec("".join(cell["source"]), scope)
     images = [s for s in shown if isinstance(s, str) and s.endswith(".png")]
     assert images and all(os.path.getsize(i) > 100 for i in images)
+
+
+def test_a_run_folder_without_launch_json_is_read_from_run_json(tmp_path):
+    """`cradle tma run --out DIR` alone: labels come from run.json (parsed values at the top,
+    the command line under "arguments")."""
+    d = tmp_path / "alone_s7"
+    ta.write_synthetic_run(str(d), "RIAC", 7, evaluations=3, test_tasks=4, episodes_per_eval=1)
+    (d / "run.json").write_text(json.dumps({
+        "arguments": {"env": "parkour", "embodiment": "fish", "exp_name": "alone"},
+        "student": "sac", "teacher": "RIAC", "expert_knowledge": "low", "seed": 7,
+        "bounds": {"names": ["a", "b"], "mins": [0, 0], "maxs": [1, 1]}}))
+    run = ta.load_run(str(d))
+    assert (run.label, run.teacher, run.ek, run.embodiment, run.seed, run.experiment) == (
+        "RIAC", "RIAC", "low", "fish", 7, "alone")
+    assert run.final == pytest.approx(float(run.progress["pct_mastered"].iloc[-1]))
