@@ -29,11 +29,17 @@ class AlpGmmTeacher final : public Teacher {
       throw UserError("alp_gmm: random_task_ratio must lie in [0, 1]");
     if (p_.criterion != "aic" && p_.criterion != "bic")
       throw UserError("alp_gmm: criterion '" + p_.criterion + "'; expected aic or bic");
+    if (p_.initial_dist) check_dist(*p_.initial_dist, "alp_gmm: initial_dist");
   }
 
   bool is_non_exploratory_task_sampling_available() const override { return fitted_; }
 
   Task sample_task() override {
+    // Bootstrap under high expert knowledge: the env's easy region (origin -2).
+    if (!fitted_ && p_.initial_dist) {
+      last_origin_ = -2;
+      return gaussian_task(*p_.initial_dist);
+    }
     // Bootstrap, before the first fit, and a random_task_ratio share: uniform (origin -1).
     if (!fitted_ || rng_.uniform() < p_.random_task_ratio) {
       last_origin_ = -1;
@@ -84,7 +90,7 @@ class AlpGmmTeacher final : public Teacher {
     nlohmann::json j = Teacher::dump();
     j["episodes"] = history_.size();
     j["fits"] = fits_;
-    j["task_origins"] = origins_;  // -1 random, j component index
+    j["task_origins"] = origins_;  // -2 initial dist, -1 random, j component index
     if (fitted_) {
       nlohmann::json comps = nlohmann::json::array();
       for (int c = 0; c < gmm_.k(); ++c)

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "teach/gmm.h"
 
 namespace cradle::teach {
 
@@ -35,6 +36,27 @@ Task Teacher::uniform_task() {
 
 void Teacher::clip(Task& task) const {
   for (std::size_t i = 0; i < task.size(); ++i) task[i] = std::clamp(task[i], mins_[i], maxs_[i]);
+}
+
+Task Teacher::gaussian_task(const DiagGaussian& dist) {
+  Task task(mins_.size());
+  for (std::size_t i = 0; i < task.size(); ++i)
+    task[i] = static_cast<float>(dist.mean[i] + std::sqrt(static_cast<double>(dist.variance[i])) *
+                                                    standard_normal(rng_));
+  clip(task);
+  return task;
+}
+
+void Teacher::check_dist(const DiagGaussian& dist, const std::string& what) const {
+  // Sizes first, then values: the message names the first fault.
+  if (dist.mean.size() != mins_.size() || dist.variance.size() != mins_.size())
+    throw UserError(what + ": mean has " + std::to_string(dist.mean.size()) + " and variance " +
+                    std::to_string(dist.variance.size()) + " values; expected " +
+                    std::to_string(mins_.size()) + " each (the task dimensions)");
+  for (std::size_t i = 0; i < mins_.size(); ++i)
+    if (!std::isfinite(dist.mean[i]) || !std::isfinite(dist.variance[i]) || dist.variance[i] < 0)
+      throw UserError(what + ": dimension " + std::to_string(i) +
+                      " has a non-finite mean or a negative variance; expected finite, >= 0");
 }
 
 nlohmann::json Teacher::dump() const {

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,15 @@
 namespace cradle::teach {
 
 using Task = std::vector<float>;
+
+// A diagonal Gaussian in the teacher's task space (an env's easy region, SPDL's target).
+struct DiagGaussian {
+  std::vector<float> mean, variance;
+};
+
+// The student's value function V(s) on a batch of states (SAC's V network, PPO's value head).
+using ValueEstimator =
+    std::function<std::vector<float>(const std::vector<std::vector<float>>& states)>;
 
 // The interface every teacher implements (hooks named as in TeachMyAgent's AbstractTeacher).
 class Teacher {
@@ -30,6 +41,8 @@ class Teacher {
   virtual void record_initial_state(const Task& /*task*/, const std::vector<float>& /*s0*/) {}
   virtual void step_update(const std::vector<float>& /*s*/, const std::vector<float>& /*a*/,
                            double /*r*/, const std::vector<float>& /*s_next*/, bool /*done*/) {}
+  // The student hands its value function over once; only SPDL uses it.
+  virtual void set_value_estimator(ValueEstimator /*estimator*/) {}
   // End of a training episode played on `task`.
   virtual void episodic_update(const Task& task, double ret, bool success) = 0;
   // Book-keeping as JSON (name, bounds, and the teacher's own records).
@@ -45,6 +58,10 @@ class Teacher {
   Task uniform_task();
   // Clips every coordinate into the box.
   void clip(Task& task) const;
+  // A draw from a diagonal Gaussian, clipped to the box.
+  Task gaussian_task(const DiagGaussian& dist);
+  // Throws UserError (naming `what`) unless dist has dims() finite means and variances >= 0.
+  void check_dist(const DiagGaussian& dist, const std::string& what) const;
 
   std::vector<float> mins_, maxs_;
   Rng rng_;
@@ -87,6 +104,7 @@ struct AlpGmmParams {
   std::vector<int> potential_ks = {2, 3, 4, 5, 6, 7, 8, 9, 10};  // benchmark 2..9
   double random_task_ratio = 0.2;                                // benchmark 0.05
   std::string criterion = "aic";                                 // or "bic"
+  std::optional<DiagGaussian> initial_dist;  // high expert knowledge: bootstrap tasks from it
 };
 // Throws UserError on a bad parameter.
 std::unique_ptr<Teacher> make_alp_gmm_teacher(std::vector<float> mins, std::vector<float> maxs,

@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "core/error.h"
 #include "envs/tma/tma_env.h"
 
 namespace cradle::envs {
@@ -27,6 +28,28 @@ TEST(TmaAdapter, SpacesObservationAndFailure) {
   EXPECT_TRUE(env.info().flag(env.info().find("is_failure")));
   EXPECT_FALSE(env.info().flag(env.info().find("is_success")));
   EXPECT_EQ(env.observation().f64(0)[1], env.env().observation()[1]);
+}
+
+// A teacher's task arrives as reset options, one per dimension (vector parameters as name_<i>).
+TEST(TmaAdapter, TakesTaskParametersAsResetOptions) {
+  TmaEnvAdapter stumps(tma::TmaOptions{.env = tma::EnvId::kStumpTracks});
+  stumps.set_reset_options({{"stump_height", 2.5}, {"obstacle_spacing", 1.5}});
+  EXPECT_EQ(stumps.env().stump_task().stump_height, 2.5);
+  EXPECT_EQ(stumps.env().stump_task().obstacle_spacing, 1.5);
+  EXPECT_THROW(stumps.set_reset_options({{"stump_heigth", 1}}), UserError);
+  EXPECT_THROW(stumps.set_reset_options({{"stump_height", 20}}), UserError);
+
+  TmaEnvAdapter parkour(tma::TmaOptions{.env = tma::EnvId::kParkour});
+  parkour.set_reset_options({{"input_vector_0", -0.2},
+                             {"input_vector_1", 0.7},
+                             {"input_vector_2", 0.1},
+                             {"water_level", 0.4}});
+  EXPECT_EQ(parkour.env().parkour_task().input_vector[1], 0.7);
+  EXPECT_EQ(parkour.env().parkour_task().water_level, 0.4);
+  // A missing index, or a vector parameter given as a scalar.
+  EXPECT_THROW(parkour.set_reset_options({{"input_vector_0", 0}, {"input_vector_2", 0}}),
+               UserError);
+  EXPECT_THROW(parkour.set_reset_options({{"input_vector", 0}}), UserError);
 }
 
 }  // namespace

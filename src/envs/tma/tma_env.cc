@@ -1,6 +1,12 @@
 #include "envs/tma/tma_env.h"
 
 #include <algorithm>
+#include <cctype>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
 
 namespace cradle::envs {
 namespace {
@@ -19,6 +25,36 @@ TmaEnvAdapter::TmaEnvAdapter(const tma::TmaOptions& options, std::shared_ptr<con
   success_slot_ = info_.declare("is_success", InfoType::kBool);
   failure_slot_ = info_.declare("is_failure", InfoType::kBool);
   copy_observation();
+}
+
+void TmaEnvAdapter::set_reset_options(const ResetOptions& options) {
+  // Group name_<i> options into the vector parameters; the env checks names and ranges.
+  std::map<std::string, std::map<int, double>> vectors;
+  std::vector<tma::TaskParam> params;
+  for (const auto& [name, value] : options) {
+    const std::size_t cut = name.rfind('_');
+    const bool indexed = cut != std::string::npos && cut + 1 < name.size() &&
+                         std::all_of(name.begin() + cut + 1, name.end(),
+                                     [](unsigned char c) { return std::isdigit(c); });
+    const std::string base = indexed ? name.substr(0, cut) : name;
+    if (indexed && (base == "input_vector" || base == "stump_width" || base == "stump_rot")) {
+      vectors[base][std::stoi(name.substr(cut + 1))] = value;
+    } else {
+      params.push_back({name, {value}});
+    }
+  }
+  for (const auto& [base, values] : vectors) {
+    tma::TaskParam p{base, {}};
+    for (const auto& [index, value] : values) {
+      if (index != static_cast<int>(p.second.size())) {
+        throw UserError("reset option " + base + "_" + std::to_string(p.second.size()) +
+                        " is missing (expected " + base + "_0, " + base + "_1, ...)");
+      }
+      p.second.push_back(value);
+    }
+    params.push_back(std::move(p));
+  }
+  env_.set_environment(params);
 }
 
 void TmaEnvAdapter::reset(std::optional<std::uint64_t> seed) {

@@ -18,6 +18,11 @@ class TmaEnvAdapter : public Env {
   const Box& action_space() const override { return action_space_; }
   void reset(std::optional<std::uint64_t> seed = std::nullopt) override;
   StepResult step(std::span<const double> action) override;
+  // A teacher's task for the following resets, one option per dimension: scalar parameters by
+  // name (stump_height), the values of a vector parameter as name_0, name_1, ... (input_vector_0,
+  // as the test-set files name them). UserError for an unknown name, a missing index or a value
+  // out of range.
+  void set_reset_options(const ResetOptions& options) override;
   const ObservationBuffers& observation() const override { return buffers_; }
   const Info& info() const override { return info_; }
   tma::TmaEnv& env() { return env_; }

@@ -1,0 +1,90 @@
+#include "train/curriculum_env.h"
+
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+
+namespace cradle::train {
+
+CurriculumEnv::CurriculumEnv(std::unique_ptr<envs::Env> inner,
+                             std::shared_ptr<teach::TeacherController> controller,
+                             CurriculumOptions options)
+    : inner_(std::move(inner)), controller_(std::move(controller)), options_(options) {
+  if (!inner_ || !controller_) throw std::invalid_argument("CurriculumEnv: null env or controller");
+  success_slot_ = inner_->info().find("is_success");
+  // Vectors sized once: a step allocates nothing.
+  flatten(s_);
+  s_next_ = s_;
+  a_.assign(inner_->action_space().size(), 0.f);
+}
+
+void CurriculumEnv::set_reset_options(const envs::ResetOptions& options) {
+  for (const auto& [name, value] : options) {
+    for (const std::string& dim : controller_->space().dim_names()) {
+      if (dim == name) {
+        throw UserError("reset option '" + name + "' is a teacher's task parameter here");
+      }
+    }
+  }
+  extra_options_ = options;
+}
+
+void CurriculumEnv::reset(std::optional<std::uint64_t> seed) {
+  // The teacher picks the next task; the env takes it as reset options.
+  task_ = controller_->sample_train_task();
+  reset_options_ = extra_options_;
+  const std::vector<std::string>& names = controller_->space().dim_names();
+  for (std::size_t i = 0; i < names.size(); ++i) reset_options_[names[i]] = task_.real[i];
+  inner_->set_reset_options(reset_options_);
+  inner_->reset(seed);
+  flatten(s_);
+  controller_->record_initial_state(task_.raw, s_);
+  return_ = 0;
+  length_ = 0;
+  in_episode_ = true;
+}
+
+envs::StepResult CurriculumEnv::step(std::span<const double> action) {
+  const envs::StepResult r = inner_->step(action);
+  const bool done = r.terminated || r.truncated;
+  return_ += r.reward;
+  ++length_;
+  // Every step to the controller (its count, SPDL's updates).
+  if (options_.step_updates) {
+    for (std::size_t i = 0; i < a_.size() && i < action.size(); ++i)
+      a_[i] = static_cast<float>(action[i]);
+    flatten(s_next_);
+    controller_->record_train_step(s_, a_, r.reward, s_next_, done);
+    std::swap(s_, s_next_);
+  }
+  // The episode's outcome to the teacher.
+  if (done && in_episode_) {
+    const bool success = std::isnan(options_.success_threshold)
+                             ? success_slot_ >= 0 && inner_->info().flag(success_slot_)
+                             : return_ > options_.success_threshold;
+    controller_->record_train_episode(task_.raw, return_, length_, success);
+    in_episode_ = false;
+  }
+  return r;
+}
+
+void CurriculumEnv::flatten(std::vector<float>& out) const {
+  const envs::ObservationBuffers& obs = inner_->observation();
+  const DictSpace& space = inner_->observation_space();
+  std::size_t n = 0;
+  for (int k = 0; k < obs.count(); ++k) {
+    const DType t = space.entries[k].second.dtype;
+    if (t == DType::kUInt8) continue;
+    const std::size_t size = t == DType::kFloat64 ? obs.f64(k).size() : obs.f32(k).size();
+    if (out.size() < n + size) out.resize(n + size);
+    if (t == DType::kFloat64) {
+      for (double v : obs.f64(k)) out[n++] = static_cast<float>(v);
+    } else {
+      for (float v : obs.f32(k)) out[n++] = v;
+    }
+  }
+  out.resize(n);
+}
+
+}  // namespace cradle::train
