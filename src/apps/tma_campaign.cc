@@ -33,6 +33,12 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "envs/tma/tma_env.h"
+#include "eval/video.h"
+#include "learn/hyperparams.h"
+#include "learn/registry.h"
+#include "learn/vector_env.h"
+#include "tma/render.h"
 
 extern char** environ;
 
@@ -639,6 +645,103 @@ int analyze(const std::string& results, const std::string& out, const std::strin
   return 0;
 }
 
+// ---- video ---------------------------------------------------------------------------------
+
+struct VideoOptions {
+  std::string run, out;
+  int test_task = 0, steps = 2000;
+  std::uint64_t seed = 0;
+  bool lidars = false;
+};
+
+// Row K of a run's test_set.csv as reset options (header task_index,<names...>).
+envs::ResetOptions test_task(const fs::path& file, int k) {
+  std::ifstream in(file);
+  if (!in)
+    throw UserError("cannot read " + file.string() + " (expected a `cradle tma run` folder)");
+  std::string header, row;
+  std::getline(in, header);
+  std::vector<std::string> names;
+  std::stringstream h(header);
+  for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  int rows = 0;
+  while (std::getline(in, row)) {
+    std::stringstream r(row);
+    std::string cell;
+    std::getline(r, cell, ',');
+    if (cell != std::to_string(k)) {
+      ++rows;
+      continue;
+    }
+    envs::ResetOptions task;
+    for (size_t i = 1; i < names.size() && std::getline(r, cell, ','); ++i) {
+      task[names[i]] = std::stod(cell);
+    }
+    return task;
+  }
+  throw UserError("--test-task " + std::to_string(k) + " (expected 0.." + std::to_string(rows - 1) +
+                  " of " + file.string() + ")");
+}
+
+// One deterministic episode of the run's latest checkpoint on test task K, rendered to a video.
+void video(const VideoOptions& o) {
+  const fs::path dir = o.run;
+  std::ifstream run_file(dir / "run.json");
+  if (!run_file) throw UserError("no run.json in " + dir.string() + " (expected a run folder)");
+  nlohmann::json run;
+  try {
+    run = nlohmann::json::parse(run_file);
+  } catch (const std::exception&) {
+    throw UserError((dir / "run.json").string() + " is not JSON");
+  }
+  const nlohmann::json args = run.value("arguments", nlohmann::json::object());
+  const std::string env_name = args.value("env", std::string("stump-tracks"));
+  const std::string body = args.value("embodiment", std::string("old_classic_bipedal"));
+  const envs::ResetOptions task = test_task(dir / "test_set.csv", o.test_task);
+  const fs::path ckpt = dir / "checkpoints" / "latest.ckpt";
+  if (!fs::exists(ckpt)) throw UserError("no checkpoint " + ckpt.string() + " (train first)");
+
+  // The learner as saved (its own hyperparameters; no replay memory needed to act).
+  const learn::CheckpointInfo info = learn::read_checkpoint_info(ckpt);
+  learn::LearnerOptions lo;
+  lo.hyperparameters = learn::parse_hyperparameter_text(info.config);
+  if (lo.hyperparameters.count("buffer_size")) lo.hyperparameters["buffer_size"] = "1000";
+  const tma::TmaOptions options{
+      .env = tma::parse_env_id(env_name), .body = body, .max_episode_steps = o.steps};
+  learn::ThreadedVecEnv vec(
+      1, [&](int) { return std::make_unique<envs::TmaEnvAdapter>(options); }, 1);
+  std::unique_ptr<learn::Learner> learner = learn::make_learner(info.algorithm, vec, lo);
+  learner->load(ckpt);
+
+  envs::TmaEnvAdapter env(options);
+  env.set_reset_options(task);
+  env.reset(o.seed);
+  const std::string out =
+      o.out.empty() ? (dir / ("test_task_" + std::to_string(o.test_task) + ".mp4")).string()
+                    : o.out;
+  const int w = 600, h = 400;
+  eval::VideoWriter writer(out, w, h, tma::kFps);
+  std::vector<std::uint8_t> frame;
+  std::vector<double> action(env.action_space().size());
+  double ret = 0;
+  int length = 0;
+  for (bool done = false; !done;) {
+    tma::render(env.env(), w, h, o.lidars, frame);
+    writer.write(frame);
+    learner->act(env.observation(), action, /*deterministic=*/true);
+    const envs::StepResult r = env.step(action);
+    ret += r.reward;
+    ++length;
+    done = r.terminated || r.truncated;
+  }
+  tma::render(env.env(), w, h, o.lidars, frame);
+  writer.write(frame);
+  writer.close();
+  std::printf("test task %d: return %.1f in %d steps (%s) after %ld training steps -> %s\n",
+              o.test_task, ret, length, ret > 230 ? "mastered" : "not mastered", info.steps,
+              out.c_str());
+}
+
 }  // namespace
 
 void register_tma_campaign(CLI::App& tma) {
@@ -692,6 +795,16 @@ void register_tma_campaign(CLI::App& tma) {
   ana->add_option("--out", ao->out, "Figures and tables folder (default RESULTS/analysis)");
   ana->add_option("--baseline", ao->baseline,
                   "Campaign compared against (default: the Random one)");
+  auto vo = std::make_shared<VideoOptions>();
+  CLI::App* vid = tma.add_subcommand("video", "Render a trained policy on one test task");
+  vid->add_option("--run", vo->run, "Run folder of `cradle tma run`")->required();
+  vid->add_option("--test-task", vo->test_task, "Row of the run's test_set.csv")->required();
+  vid->add_option("--out", vo->out, "Video file (.mp4 / .avi; default RUN/test_task_K.mp4)");
+  vid->add_option("--steps", vo->steps, "Episode step cap")->check(CLI::Range(1, 100000));
+  vid->add_option("--seed", vo->seed, "Seed of the episode");
+  vid->add_flag("--lidars", vo->lidars, "Draw the lidar rays");
+  vid->callback([vo] { video(*vo); });
+
   ana->callback([ao] {
     analyze(ao->results, ao->out.empty() ? (fs::path(ao->results) / "analysis").string() : ao->out,
             ao->baseline);

@@ -16,6 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "envs/tma/tma_env.h"
+#include "learn/registry.h"
+#include "learn/run_files.h"
+#include "learn/vector_env.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -293,6 +298,42 @@ TEST(TmaCampaign, SlurmRunsTheMiniCampaign) {
   EXPECT_TRUE(fs::exists(results / "alp_c1_allow_expert_knowledge_none" / "launch" / "commit.txt"));
   if (r.status == 0) expect_analysis(results);
   if (!was_up) shell(script + " stop");
+  fs::remove_all(dir);
+}
+
+// `cradle tma video`: a run folder whose checkpoint is an (untrained) SAC student, as `cradle tma
+// run` saves it, renders test task 1 to a video; bad folders and tasks are one-line errors.
+TEST(TmaCampaign, VideoRendersTheCheckpointOnATestTask) {
+  const fs::path dir = fresh("video");
+  std::ofstream(dir / "run.json")
+      << R"({"arguments": {"env": "stump-tracks", "embodiment": "old_classic_bipedal"}})";
+  std::ofstream(dir / "test_set.csv") << "task_index,stump_height,obstacle_spacing\n"
+                                      << "0,0.5,3\n1,0,6\n";
+  {
+    const cradle::tma::TmaOptions options{.env = cradle::tma::EnvId::kStumpTracks,
+                                          .body = "old_classic_bipedal"};
+    cradle::learn::ThreadedVecEnv vec(
+        1, [&](int) { return std::make_unique<cradle::envs::TmaEnvAdapter>(options); }, 1);
+    cradle::learn::LearnerOptions lo;
+    lo.hyperparameters = {{"buffer_size", "500"}, {"pi_layers", "32,32"}, {"qf_layers", "32,32"}};
+    const auto learner = cradle::learn::make_learner("sac", vec, lo);
+    fs::create_directories(dir / "checkpoints");
+    cradle::learn::save_run_checkpoint(dir / "checkpoints" / "latest.ckpt", *learner, nullptr, {});
+  }
+  const fs::path out = dir / "task1.mp4";
+  CliResult r =
+      cradle("tma video --run " + dir.string() + " --test-task 1 --steps 40 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("test task 1: return"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after 0 training steps"), std::string::npos) << r.out;
+  EXPECT_GT(fs::file_size(out), 1000u);
+  for (const std::string& args :
+       {"tma video --run " + dir.string() + " --test-task 2",
+        "tma video --run " + (dir / "none").string() + " --test-task 0"}) {
+    r = cradle(args);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  }
   fs::remove_all(dir);
 }
 
