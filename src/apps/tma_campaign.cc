@@ -169,8 +169,9 @@ std::vector<CampaignLine> read_campaign(const fs::path& file) {
 struct GenerateOptions {
   std::string name, teacher, preset = "paper", out;
   std::vector<std::string> teacher_params;
-  double steps = 0;  // millions; 0: the preset's
-  int seeds = 0;     // 0: the preset's
+  double steps = 0;        // millions; 0: the preset's
+  int seeds = 0;           // 0: the preset's
+  int test_episodes = -1;  // 0: the named test sets (paper); N: N default test tasks; -1: preset's
 };
 
 // Teachers that refuse to run without expert knowledge (spec §1.3).
@@ -201,10 +202,11 @@ std::string generate(const GenerateOptions& o) {
     }
   }
   const bool paper = o.preset == "paper";
-  const double steps = o.steps > 0 ? o.steps : (paper ? 20.0 : 0.1);
+  const double steps = o.steps > 0 ? o.steps : (paper ? 20.0 : 0.02);
   const int seeds = o.seeds > 0 ? o.seeds : (paper ? 16 : 2);
-  // Paper: 40 evaluations (every 500 k steps at 20 M); mini: 5.
-  const long test_every = std::max(1L, std::lround(steps * 1e6 / (paper ? 40 : 5)));
+  const int test_episodes = o.test_episodes >= 0 ? o.test_episodes : (paper ? 0 : 10);
+  // Paper: 40 evaluations (every 500 k steps at 20 M); mini: 2.
+  const long test_every = std::max(1L, std::lround(steps * 1e6 / (paper ? 40 : 2)));
   const long periodical = std::max(1L, test_every / 2);
   const bool is_adr = o.teacher == "ADR";
   const bool is_random = o.teacher == "Random";
@@ -214,7 +216,12 @@ std::string generate(const GenerateOptions& o) {
   const std::string budget = "--nb_env_steps " + number(steps) + " --test_every " +
                              std::to_string(test_every) + " --keep_periodical_task_samples " +
                              std::to_string(periodical);
-  const std::string stumps = "--env stump-tracks --test_set parametric_stumps_test_set";
+  // The reference's test sets (100 tasks each), or N tasks of the default set (cheaper).
+  const auto test_set = [&](const std::string& name) {
+    return test_episodes == 0 ? "--test_set " + name
+                              : "--nb_test_episodes " + std::to_string(test_episodes);
+  };
+  const std::string stumps = "--env stump-tracks " + test_set("parametric_stumps_test_set");
 
   std::ostringstream f;
   f << "# cradle tma campaign: " << o.name << " (teacher " << o.teacher << ", preset " << o.preset
@@ -263,11 +270,11 @@ std::string generate(const GenerateOptions& o) {
   f << "#### Global performance: Parkour, three embodiments with distinct seeds, low EK\n";
   const std::string parkour = "--env parkour --student sac --allow_expert_knowledge low";
   line(seeds, "", "parkour",
-       parkour + " --*embodiment old_classic_bipedal --test_set walking_test_set_v1");
+       parkour + " --*embodiment old_classic_bipedal " + test_set("walking_test_set_v1"));
   line(seeds, "+" + std::to_string(seeds), "parkour",
-       parkour + " --*embodiment climbing_profile_chimpanzee --test_set climbing_test_set_v1");
+       parkour + " --*embodiment climbing_profile_chimpanzee " + test_set("climbing_test_set_v1"));
   line(seeds, "+" + std::to_string(2 * seeds), "parkour",
-       parkour + " --*embodiment fish --test_set swimming_test_set_v1");
+       parkour + " --*embodiment fish " + test_set("swimming_test_set_v1"));
   f << "#### Upper baseline: the plain [0, 3] x [0, 6] space\n";
   for (const std::string& ek : levels) {
     line(2 * seeds, "", "upper_baseline",
@@ -754,7 +761,10 @@ void register_tma_campaign(CLI::App& tma) {
   gen->add_option("--teacher", go->teacher, "Teacher (Random, ADR, ALP-GMM, RIAC, ...)")
       ->required();
   gen->add_option("--teacher-param", go->teacher_params, "Teacher parameter key=value");
-  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.1)")
+  gen->add_option("--test-episodes", go->test_episodes,
+                  "0: the reference's test sets (paper); N: N default test tasks (mini 10)")
+      ->check(CLI::Range(0, 100000));
+  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.02)")
       ->check(CLI::PositiveNumber);
   gen->add_option("--seeds", go->seeds, "Seeds per configuration (paper 16, mini 2)")
       ->check(CLI::Range(1, 100000));

@@ -146,11 +146,14 @@ TEST(TmaCampaign, GeneratesBothExperimentsWithTheReferenceSeeds) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   lines = config_lines(text);
   EXPECT_EQ(count(lines, "--seeds 2 "), 9);
-  EXPECT_EQ(count(lines, "--nb_env_steps 0.1 --test_every 20000"), 12);
+  EXPECT_EQ(count(lines, "--nb_env_steps 0.02 --test_every 10000"), 12);
+  EXPECT_EQ(count(lines, "--nb_test_episodes 10 "), 12);
+  EXPECT_EQ(count(lines, "--test_set"), 0);
   r = cradle("tma campaign generate m --teacher Random --steps 2 --seeds 4");
   lines = config_lines(r.out);
   EXPECT_EQ(count(lines, "--seeds 4+8 "), 1);
   EXPECT_EQ(count(lines, "--nb_env_steps 2 --test_every 50000"), 12);
+  EXPECT_EQ(count(lines, "--test_set parametric_stumps_test_set"), 9);
   // The generated file is a valid campaign: the dry run lists every seed.
   r = cradle("tma campaign launch " + (dir / "m.txt").string() + " --local --dry-run --results " +
              (dir / "res").string());
