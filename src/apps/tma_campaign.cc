@@ -60,6 +60,7 @@ struct CampaignLine {
 // Arguments the launcher sets itself for every seed.
 const std::set<std::string> kLauncherArgs = {"--seed", "--out", "--resume", "--exp_name"};
 
+// Names become folder names: no separators, spaces or shell characters.
 bool valid_name(const std::string& s) {
   if (s.empty()) return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
@@ -302,10 +303,12 @@ struct SeedRun {
   fs::path dir;
 };
 
+// The run's own done.json or the launcher's marker after exit status 0.
 bool finished(const fs::path& dir) {
   return fs::exists(dir / "done.json") || fs::exists(dir / "finished");
 }
 
+// A word for bash: as is when plain, else single-quoted.
 std::string quote(const std::string& s) {
   const bool plain = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) ||
