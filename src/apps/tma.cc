@@ -1,11 +1,15 @@
-// `cradle tma random|bench|info`: TeachMyAgent's environments from the command line.
+// `cradle tma random|bench|info|run`: TeachMyAgent's environments from the command line.
+//   run    --env ... --embodiment E --student sac|ppo --teacher T [...]: a student trained with a
+//          teacher, the reference's run.py (train/tma_run.h; run folder in docs/tma_run.md);
 //   random --env stump-tracks|parkour --embodiment E [--task k=v ...] [--video out.mp4]
 //          [--steps N] [--seed S] [--png F]: one random-policy episode (return, length, success);
 //   bench  --env ... --embodiment E|all [--steps N] [--json]: env steps/s and the ratio to the
 //          bare b2World::Step on the same world, measured in one run, plus the reset time;
 //   info   : observation / action sizes and masses of every embodiment in both envs (JSON).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -15,10 +19,13 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/rng.h"
+#include "envs/tma/tma_env.h"
 #include "eval/video.h"
 #include "model/textures.h"
+#include "tma/cppn.h"
 #include "tma/render.h"
 #include "tma/tma_env.h"
+#include "train/tma_run.h"
 
 namespace cradle::apps {
 namespace {
@@ -99,6 +106,75 @@ BenchResult bench_one(tma::EnvId id, const std::string& body, int steps, std::ui
   r.bare_steps_per_s = steps / bare_s;
   r.ratio = env_s / bare_s;
   return r;
+}
+
+// "k=v" -> (k, v) or a one-line error naming the flag.
+std::pair<std::string, std::string> key_value(const std::string& flag, const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UserError(flag + " '" + text + "': expected name=value");
+  }
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+// The source tree's commit (through the data folder it ships), or "unknown".
+std::string source_commit() {
+  const std::filesystem::path dir = tma::data_dir();
+  const std::string command = "git -C '" + dir.string() + "' rev-parse HEAD 2>/dev/null";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return "unknown";
+  char buf[64] = "";
+  const bool read = std::fgets(buf, sizeof buf, pipe) != nullptr;
+  pclose(pipe);
+  std::string out = read ? buf : "";
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out.size() == 40 ? out : "unknown";
+}
+
+struct RunOptions {
+  std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
+  std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
+  std::vector<std::string> teacher_params, hp;
+  double nb_env_steps = 20, lr = 0, min_stump_h = 0, max_stump_h = 3, max_obstacle_spacing = 6;
+  long test_every = 500000, keep_periodical_task_samples = 0, reset_frequency = 0;
+  int nb_test_episodes = 100;
+  std::uint64_t seed = 0;
+  bool shuffle_dimensions = false, scale_reward = false, resume = false, no_progress = false;
+};
+
+// The env family's half of a student run: envs, bounds, test set and benchmark facts.
+train::StudentEnv tma_student_env(const RunOptions& ro) {
+  const tma::EnvId id = tma::parse_env_id(ro.env);
+  const tma::TmaOptions options{.env = id, .body = ro.body};
+  const tma::TmaEnv probe(options);  // refuses an unknown embodiment now
+  using J = nlohmann::ordered_json;
+  // Stump Tracks: the criteria's 2-D space (spec §5); Parkour: the benchmark's (spec §3.2).
+  J bounds;
+  if (id == tma::EnvId::kStumpTracks) {
+    bounds["stump_height"] = {ro.min_stump_h, ro.max_stump_h};
+    bounds["obstacle_spacing"] = {0.0, ro.max_obstacle_spacing};
+  } else {
+    bounds = J::parse(R"({
+        "input_vector": [[-0.35, 0.05], [0.6, 1.0], [-0.1, 0.3]], "water_level": [0, 1],
+        "creepers_width": [0.25, 0.25], "creepers_height": [0, 4], "creepers_spacing": [0, 5],
+        "terrain_cppn_scale": [10, 10]})");
+  }
+  train::StudentEnv env{
+      .make = [options] { return std::make_unique<envs::TmaEnvAdapter>(options); },
+      .space = teach::TaskSpace::from_json(bounds),
+      .reward_lb = -150,
+      .reward_ub = id == tma::EnvId::kStumpTracks ? 350.0 : 360.0};
+  // Stump Tracks' easy corner (high expert knowledge): no stumps, the largest spacing.
+  if (id == tma::EnvId::kStumpTracks) {
+    const float h = static_cast<float>(ro.max_stump_h - ro.min_stump_h);
+    const float sp = static_cast<float>(ro.max_obstacle_spacing);
+    env.initial_dist =
+        teach::DiagGaussian{.mean = {0.f, sp}, .variance = {0.01f * h * h, 0.01f * sp * sp}};
+  }
+  if (!ro.test_set.empty()) {
+    env.test_set = teach::read_test_set_csv(tma::data_dir() / (ro.test_set + ".csv"), env.space);
+  }
+  return env;
 }
 
 }  // namespace
@@ -213,6 +289,101 @@ void register_tma(CLI::App& app) {
       }
     }
     if (bo->json) std::printf("%s\n", out.dump(2).c_str());
+  });
+
+  auto rn = std::make_shared<RunOptions>();
+  CLI::App* run = tma_cmd->add_subcommand("run", "Train a student with a teacher (run.py)");
+  run->add_option("--exp_name", rn->exp_name, "Experiment name (default run folder)");
+  run->add_option("--env", rn->env, "stump-tracks | parkour (or the reference ids)");
+  run->add_option("--embodiment", rn->body, "Embodiment (see `cradle tma info`)");
+  run->add_option("--student", rn->student, "sac | ppo (the reference presets)");
+  run->add_option("--teacher", rn->teacher,
+                  "Random, ADR, ALP-GMM, Covar-GMM, RIAC, Self-Paced, GoalGAN, Setter-Solver");
+  run->add_option("--teacher-param", rn->teacher_params,
+                  "Teacher kwarg by the reference's name, k=v (v as JSON; repeatable)");
+  run->add_option("--allow_expert_knowledge", rn->expert_knowledge, "none | low | high");
+  run->add_option("--nb_env_steps", rn->nb_env_steps, "Training env steps, in millions");
+  run->add_option("--test_set", rn->test_set,
+                  "Test set of data/teachmyagent (e.g. parametric_stumps_test_set); default: "
+                  "the grid (Stump Tracks) or 100 fixed uniform tasks");
+  run->add_option("--nb_test_episodes,--nb_test_episode", rn->nb_test_episodes,
+                  "Size of the default test set");
+  run->add_option("--seed", rn->seed, "Seed of the student, teacher and shuffling");
+  run->add_option("--keep_periodical_task_samples", rn->keep_periodical_task_samples,
+                  "Env steps between 100-task curriculum snapshots (0: none)");
+  run->add_flag("--shuffle_dimensions", rn->shuffle_dimensions, "Rugged difficulty (4x4)");
+  run->add_flag("--scale_reward", rn->scale_reward, "The teacher sees returns scaled to [0, 1]");
+  run->add_option("--test_every,--steps_per_ep", rn->test_every, "Env steps between evaluations");
+  run->add_option("--reset_frequency", rn->reset_frequency,
+                  "Env steps between student resets (0: never; criterion 3: 7000000)");
+  run->add_option("--min_stump_h", rn->min_stump_h, "Stump Tracks: lowest mean stump height");
+  run->add_option("--max_stump_h", rn->max_stump_h, "Stump Tracks: highest mean stump height");
+  run->add_option("--max_obstacle_spacing", rn->max_obstacle_spacing,
+                  "Stump Tracks: largest spacing");
+  run->add_option("--lr", rn->lr, "Student learning rate (default: the preset's)");
+  run->add_option("--hp", rn->hp, "Student hyperparameter override name=value (repeatable)");
+  run->add_option("--out", rn->out, "Run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)");
+  run->add_flag("--resume", rn->resume, "Continue the run in --out from its last checkpoint");
+  run->add_flag("--no-progress", rn->no_progress, "No progress bar");
+  run->callback([rn] {
+    const RunOptions& ro = *rn;
+    if (!(ro.nb_env_steps > 0) || !std::isfinite(ro.nb_env_steps)) {
+      throw UserError("--nb_env_steps " + std::to_string(ro.nb_env_steps) +
+                      " (expected a positive number of millions)");
+    }
+    train::StudentRunOptions o{.student = ro.student,
+                               .teacher = ro.teacher,
+                               .expert_knowledge = ro.expert_knowledge,
+                               .total_steps = std::lround(ro.nb_env_steps * 1e6),
+                               .test_every = ro.test_every,
+                               .nb_test_episodes = ro.nb_test_episodes,
+                               .seed = ro.seed,
+                               .keep_periodical_task_samples = ro.keep_periodical_task_samples,
+                               .shuffle_dimensions = ro.shuffle_dimensions,
+                               .scale_reward = ro.scale_reward,
+                               .reset_frequency = ro.reset_frequency,
+                               .resume = ro.resume,
+                               .progress_bar = !ro.no_progress};
+    for (const std::string& kv : ro.teacher_params) {
+      const auto [k, v] = key_value("--teacher-param", kv);
+      o.teacher_params[k] =
+          nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
+    }
+    if (ro.lr != 0) o.hyperparameters["learning_rate"] = std::to_string(ro.lr);
+    for (const std::string& kv : ro.hp) o.hyperparameters.insert(key_value("--hp", kv));
+    o.out = ro.out.empty() ? std::filesystem::path("tma_runs") / ro.exp_name /
+                                 (ro.exp_name + "_s" + std::to_string(ro.seed))
+                           : std::filesystem::path(ro.out);
+    o.arguments = {{"exp_name", ro.exp_name},
+                   {"env", ro.env},
+                   {"embodiment", ro.body},
+                   {"student", ro.student},
+                   {"teacher", ro.teacher},
+                   {"teacher_params", o.teacher_params},
+                   {"allow_expert_knowledge", ro.expert_knowledge},
+                   {"nb_env_steps", ro.nb_env_steps},
+                   {"test_set", ro.test_set},
+                   {"nb_test_episodes", ro.nb_test_episodes},
+                   {"seed", ro.seed},
+                   {"keep_periodical_task_samples", ro.keep_periodical_task_samples},
+                   {"shuffle_dimensions", ro.shuffle_dimensions},
+                   {"scale_reward", ro.scale_reward},
+                   {"test_every", ro.test_every},
+                   {"reset_frequency", ro.reset_frequency},
+                   {"min_stump_h", ro.min_stump_h},
+                   {"max_stump_h", ro.max_stump_h},
+                   {"max_obstacle_spacing", ro.max_obstacle_spacing},
+                   {"lr", ro.lr},
+                   {"hp", ro.hp},
+                   {"out", o.out.string()},
+                   {"resume", ro.resume}};
+    o.commit = source_commit();
+    const train::StudentRunResult r = train::run_student(tma_student_env(ro), o);
+    std::printf(
+        "%s: %ld env steps, %ld episodes, %d evaluations, %.1f s, %.0f env steps/s, %.1f "
+        "gradient steps/s, teacher %.2f%% of the time, %.0f%% mastered\n",
+        o.out.string().c_str(), r.env_steps, r.episodes, r.evaluations, r.wall_s, r.env_steps_per_s,
+        r.gradient_steps_per_s, 100 * r.teacher_s / std::max(r.wall_s, 1e-9), r.last_pct_mastered);
   });
 
   CLI::App* info = tma_cmd->add_subcommand("info", "Spaces and masses per embodiment (JSON)");

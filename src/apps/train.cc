@@ -55,6 +55,9 @@ void register_train(CLI::App& app) {
                   "Env steps between checkpoints")
       ->check(CLI::Range(1L, 100000000000L));
   cmd->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
+  cmd->add_option("--task-space", opts->train.task_space,
+                  "Curriculum: task-space YAML whose teacher sets the reset options");
+  cmd->add_option("--teacher", opts->train.teacher, "Curriculum teacher (overrides the file's)");
   cmd->add_option("--eval-episodes", opts->train.eval_episodes, "Evaluation episodes at the end")
       ->check(CLI::Range(0, 100000));
   cmd->add_flag("--compare-random", opts->train.compare_random,

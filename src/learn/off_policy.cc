@@ -19,6 +19,8 @@ void OffPolicyConfig::bind(Hyperparameters& table) {
   table.add("gamma", &gamma, "discount factor");
   table.add("train_freq", &train_freq, "vector steps between trainings");
   table.add("gradient_steps", &gradient_steps, "gradient steps per training");
+  table.add("episode_train_freq", &episode_train_freq,
+            "> 0: at each episode end, ceil(length / this) gradient steps (SpinningUp SAC)");
   table.add("report_every", &report_every, "vector steps between progress reports");
 }
 
@@ -29,6 +31,7 @@ void OffPolicyConfig::check(std::string_view algorithm) const {
                     ": batch_size, train_freq, gradient_steps and report_every must be positive");
   }
   if (learning_starts < 0) throw UserError(name + ": learning_starts must be >= 0");
+  if (episode_train_freq < 0) throw UserError(name + ": episode_train_freq must be >= 0");
   if (!(tau > 0 && tau <= 1)) throw UserError(name + ": tau must be in (0, 1]");
   if (!(gamma >= 0 && gamma <= 1)) throw UserError(name + ": gamma must be in [0, 1]");
   if (!(learning_rate > 0)) throw UserError(name + ": learning_rate must be positive");
@@ -124,6 +127,8 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   torch::Tensor random = torch::zeros({envs, action_size()}, torch::kFloat32);
   records_.clear();
   double collect_seconds = 0, update_seconds = 0;  // since the last report
+  std::vector<long> episode_length(envs, 0);       // episode_train_freq: steps per env
+  std::vector<std::uint8_t> episode_ended(envs, 0);
   while (steps_ < total_steps) {
     // Act: uniformly at random until learning_starts, then the algorithm's exploration.
     const Clock::time_point collect_start = Clock::now();
@@ -140,10 +145,25 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     const Clock::time_point update_start = Clock::now();
     collect_seconds += std::chrono::duration<double>(update_start - collect_start).count();
 
-    // Train every train_freq vector steps once the buffer holds more than learning_starts.
-    if (vector_steps_ % config_.train_freq == 0 && buffer_.size() > config_.learning_starts) {
+    // Train every train_freq vector steps once the buffer holds more than learning_starts
+    // (episode_train_freq > 0: at episode ends, as many updates as the episode asks).
+    int updates = vector_steps_ % config_.train_freq == 0 ? config_.gradient_steps : 0;
+    if (config_.episode_train_freq > 0) {
+      updates = 0;
+      for (int e = 0; e < envs; ++e) {
+        // An autoreset step (the one after a done step) is no step of the new episode.
+        if (std::exchange(episode_ended[e], 0)) continue;
+        ++episode_length[e];
+        if (!env_.terminated()[e] && !env_.truncated()[e]) continue;
+        updates += static_cast<int>((episode_length[e] + config_.episode_train_freq - 1) /
+                                    config_.episode_train_freq);
+        episode_length[e] = 0;
+        episode_ended[e] = 1;
+      }
+    }
+    if (updates > 0 && buffer_.size() > config_.learning_starts) {
       const ScopedTorchThreads threads(update_threads_);
-      for (int g = 0; g < config_.gradient_steps; ++g) {
+      for (int g = 0; g < updates; ++g) {
         ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
         pipeline_.normalize(batch.observations.vector, batch.observations.vector);
         pipeline_.normalize(batch.next_observations.vector, batch.next_observations.vector);
@@ -158,6 +178,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     records_.clear();
     stats.losses["learning_rate"] = config_.learning_rate;
     stats.losses["buffer_transitions"] = static_cast<double>(buffer_.size());
+    stats.losses["updates"] = static_cast<double>(updates_);  // gradient steps so far
     stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
     stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
     const EpisodeStats::Summary episodes = collector_.episodes().take();

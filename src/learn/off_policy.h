@@ -41,7 +41,10 @@ struct OffPolicyConfig {
   double gamma = 0.99;           // discount factor
   int train_freq = 1;            // vector steps between trainings (SB3 train_freq, "step")
   int gradient_steps = 1;        // updates per training
-  int report_every = 1000;       // vector steps between progress reports (not SB3)
+  // > 0: train only when an episode ends, ceil(its length / episode_train_freq) updates
+  // (SpinningUp's SAC, TeachMyAgent's student: 10); train_freq and gradient_steps are then unused.
+  int episode_train_freq = 0;
+  int report_every = 1000;  // vector steps between progress reports (not SB3)
   void bind(Hyperparameters& table);
   void check(std::string_view algorithm) const;  // UserError for a bad value
 };

@@ -37,8 +37,8 @@ void check_env_memory(const envs::BabyBenchAssets& assets, int num_envs) {
 
 std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
                                                               int threads, bool training,
-                                                              std::uint64_t seed,
-                                                              long continue_log) {
+                                                              std::uint64_t seed, long continue_log,
+                                                              const EnvWrapper& wrap) {
   using learn::ThreadedVecEnv;
   if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
   // One compiled model for all; one training log shared by all (it is thread-safe).
@@ -53,7 +53,7 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
       [&](int i) {
         auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
         if (log) env->attach_log(log, i);
-        return env;
+        return wrap ? wrap(std::move(env)) : std::unique_ptr<envs::Env>(std::move(env));
       },
       threads);
   if (log) vec->set_after_step([log] { log->commit(); });

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include "core/config.h"
@@ -15,9 +16,12 @@ namespace cradle::train {
 // <save_dir> as envs::make_env does and attaches one shared training log to every env, written in
 // env order; continue_log >= 0 continues the log that holds that many entries (resume). Refuses
 // (UserError) a vector that would not fit in memory.
+// `wrap`, when given, wraps each env (e.g. in a CurriculumEnv).
+using EnvWrapper = std::function<std::unique_ptr<envs::Env>(std::unique_ptr<envs::Env>)>;
 std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
                                                               int threads, bool training,
                                                               std::uint64_t seed,
-                                                              long continue_log = -1);
+                                                              long continue_log = -1,
+                                                              const EnvWrapper& wrap = nullptr);
 
 }  // namespace cradle::train

@@ -1,11 +1,21 @@
 #include "train/curriculum_env.h"
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
 #include "core/error.h"
 
 namespace cradle::train {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
 
 CurriculumEnv::CurriculumEnv(std::unique_ptr<envs::Env> inner,
                              std::shared_ptr<teach::TeacherController> controller,
@@ -32,14 +42,18 @@ void CurriculumEnv::set_reset_options(const envs::ResetOptions& options) {
 
 void CurriculumEnv::reset(std::optional<std::uint64_t> seed) {
   // The teacher picks the next task; the env takes it as reset options.
+  Clock::time_point start = Clock::now();
   task_ = controller_->sample_train_task();
+  teacher_seconds_ += since(start);
   reset_options_ = extra_options_;
   const std::vector<std::string>& names = controller_->space().dim_names();
   for (std::size_t i = 0; i < names.size(); ++i) reset_options_[names[i]] = task_.real[i];
   inner_->set_reset_options(reset_options_);
   inner_->reset(seed);
   flatten(s_);
+  start = Clock::now();
   controller_->record_initial_state(task_.raw, s_);
+  teacher_seconds_ += since(start);
   return_ = 0;
   length_ = 0;
   in_episode_ = true;
@@ -50,6 +64,7 @@ envs::StepResult CurriculumEnv::step(std::span<const double> action) {
   const bool done = r.terminated || r.truncated;
   return_ += r.reward;
   ++length_;
+  const Clock::time_point start = Clock::now();
   // Every step to the controller (its count, SPDL's updates).
   if (options_.step_updates) {
     for (std::size_t i = 0; i < a_.size() && i < action.size(); ++i)
@@ -66,6 +81,7 @@ envs::StepResult CurriculumEnv::step(std::span<const double> action) {
     controller_->record_train_episode(task_.raw, return_, length_, success);
     in_episode_ = false;
   }
+  teacher_seconds_ += since(start);
   return r;
 }
 

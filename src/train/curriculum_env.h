@@ -47,6 +47,8 @@ class CurriculumEnv : public envs::Env {
   envs::Env& inner() { return *inner_; }
   // The task of the current episode (real space) and the teacher's vector for it.
   const teach::SampledTask& task() const { return task_; }
+  // Seconds spent in the controller (the teacher's share of a run).
+  double teacher_seconds() const { return teacher_seconds_; }
 
  private:
   void flatten(std::vector<float>& out) const;  // every non-image observation key, as floats
@@ -57,7 +59,7 @@ class CurriculumEnv : public envs::Env {
   envs::ResetOptions reset_options_, extra_options_;
   teach::SampledTask task_;
   std::vector<float> s_, s_next_, a_;
-  double return_ = 0;
+  double return_ = 0, teacher_seconds_ = 0;
   int length_ = 0, success_slot_ = -1;
   bool in_episode_ = false;
 };

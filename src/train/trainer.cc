@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <vector>
 
 #include "core/error.h"
@@ -19,6 +20,8 @@
 #include "learn/run_files.h"
 #include "learn/vector_env.h"
 #include "train/babybench_vector.h"
+#include "train/curriculum_env.h"
+#include "train/task_space.h"
 
 namespace cradle::train {
 namespace {
@@ -129,13 +132,51 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   const fs::path log_file = dir / "logs" / "training.jsonl";
   const long kept_episodes = options.resume ? cut_training_log(log_file, resumed.episodes) : -1;
 
+  // A curriculum wraps every env: the teacher sets its reset options before each reset.
+  std::shared_ptr<teach::TeacherController> curriculum;
+  EnvWrapper wrap;
+  if (!options.teacher.empty() && options.task_space.empty())
+    throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
+  if (!options.task_space.empty()) {
+    CurriculumSpec spec = load_task_space(options.task_space);
+    if (!options.teacher.empty()) spec.teacher = options.teacher;
+    curriculum = make_controller(spec, options.seed);
+    if (options.resume && fs::exists(dir / "logs" / "teacher.jsonl")) {
+      for (const nlohmann::json& e : read_jsonl(dir / "logs" / "teacher.jsonl"))
+        if (e.value("kind", "") == "train")
+          curriculum->replay_train_episode(e["task"].get<teach::Task>(), e["return"], e["length"],
+                                           e["success"], e["env_steps"]);
+    }
+    wrap = [curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
+      return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
+    };
+  }
+  std::optional<JsonlWriter> teacher_log;
+  if (curriculum) teacher_log.emplace(dir / "logs" / "teacher.jsonl", options.resume);
+  auto write_teacher_log = [&](bool dump) {
+    if (!teacher_log) return;
+    for (const teach::EpisodeRecord& e : curriculum->take_episodes())
+      teacher_log->write({{"kind", "train"},
+                          {"episode", e.episode},
+                          {"env_steps", e.env_steps},
+                          {"task", e.task},
+                          {"return", e.ret},
+                          {"length", e.length},
+                          {"success", e.success}});
+    if (dump)
+      teacher_log->write({{"kind", "dump"},
+                          {"env_steps", curriculum->env_steps()},
+                          {"teacher", curriculum->teacher_dump()}});
+    teacher_log->flush();
+  };
   auto vec = make_babybench_vec_env(config, options.envs, options.threads, /*training=*/true,
-                                    options.seed, kept_episodes);
+                                    options.seed, kept_episodes, wrap);
   std::vector<envs::BabyBenchEnv*> envs;
   for (int i = 0; i < vec->num_envs(); ++i) {
     if (options.randomize_start) vec->env(i).set_reset_options({{"randomize_start", 1}});
     // The family's own: a resumed run's first reset ends no episode of this run's log.
-    envs.push_back(&dynamic_cast<envs::BabyBenchEnv&>(vec->env(i)));
+    auto* wrapped = dynamic_cast<CurriculumEnv*>(&vec->env(i));
+    envs.push_back(&dynamic_cast<envs::BabyBenchEnv&>(wrapped ? wrapped->inner() : vec->env(i)));
     if (options.resume) envs.back()->skip_next_record();
   }
   const std::shared_ptr<envs::TrainingLog> training_log = envs[0]->log();
@@ -207,6 +248,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   double last_score = std::nan("");
   auto on_progress = [&](const TrainStats& s) {
     check_finite_losses(s, latest);
+    write_teacher_log(false);
     if (reward) reward->update();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     if (score_count > 0) last_score = score_sum / score_count;
@@ -278,6 +320,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     files.push_back(checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"));
   }
   save_checkpoint(files);
+  write_teacher_log(true);
   for (envs::BabyBenchEnv* env : envs) env->close();
   if (!rows.empty()) plot_curves(rows, dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).

@@ -45,6 +45,10 @@ struct TrainOptions {
   // Extra reward terms (e.g. Python callables), called after the named intrinsic rewards with
   // the same arguments; they may add to the rewards in place.
   learn::RewardHook reward_hook;
+  // A curriculum (docs/curricula.md): a task-space YAML whose teacher picks every episode's reset
+  // options; `teacher` overrides the file's. Its book goes to <save_dir>/logs/teacher.jsonl.
+  std::string task_space;
+  std::string teacher;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
 };

@@ -275,6 +275,32 @@ TEST(OffPolicyCheckpoint, SacWithImagesRestoresActions) { check_checkpoint("sac"
 TEST(OffPolicyCheckpoint, Td3RestoresActions) { check_checkpoint("td3", false); }
 TEST(OffPolicyCheckpoint, DdpgRestoresActions) { check_checkpoint("ddpg", false); }
 
+// SpinningUp's schedule: ceil(length / 10) updates when each episode ends, none in between.
+TEST(Sac, TrainsAtEpisodeEndsWithEpisodeTrainFreq) {
+  auto env = testing::make_pendulums(2, 25);
+  auto sac = make_learner("sac", *env,
+                          {.seed = 1,
+                           .hyperparameters = {{"episode_train_freq", "10"},
+                                               {"learning_starts", "0"},
+                                               {"batch_size", "8"},
+                                               {"pi_layers", "8"},
+                                               {"qf_layers", "8"},
+                                               {"report_every", "1"}}});
+  std::vector<double> updates;
+  sac->learn(200, [&](const TrainStats& s) {
+    updates.push_back(s.losses.at("updates"));
+    return true;
+  });
+  // 100 vector steps of two envs: 26 per episode (25 steps and the autoreset), 3 episodes each.
+  ASSERT_EQ(updates.size(), 100u);
+  EXPECT_EQ(updates[23], 0);  // nothing before the first episode ends (step 25)
+  EXPECT_EQ(updates[24], 6);  // two episodes of 25 steps: 2 x ceil(25 / 10)
+  EXPECT_EQ(updates[49], 6);
+  EXPECT_EQ(updates.back(), 18);
+  EXPECT_THROW(make_learner("sac", *env, {.hyperparameters = {{"episode_train_freq", "-1"}}}),
+               UserError);
+}
+
 TEST(Sac, DeterministicGivenTheSeed) {
   auto env_a = testing::make_cartpoles(2, 30);
   auto env_b = testing::make_cartpoles(2, 30);

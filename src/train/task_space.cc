@@ -1,0 +1,128 @@
+#include "train/task_space.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "teach/registry.h"
+
+namespace cradle::train {
+namespace {
+
+// YAML -> JSON: maps keep their order; scalars become integers, numbers, booleans or strings.
+nlohmann::ordered_json to_json(const YAML::Node& node) {
+  if (node.IsMap()) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::object();
+    for (const auto& item : node) out[item.first.as<std::string>()] = to_json(item.second);
+    return out;
+  }
+  if (node.IsSequence()) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const auto& item : node) out.push_back(to_json(item));
+    return out;
+  }
+  if (node.IsNull()) return nullptr;
+  const std::string text = node.Scalar();
+  long i = 0;
+  double d = 0;
+  bool b = false;
+  if (YAML::convert<long>::decode(node, i)) return i;
+  if (YAML::convert<double>::decode(node, d)) return d;
+  if (YAML::convert<bool>::decode(node, b)) return b;
+  return text;
+}
+
+}  // namespace
+
+CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source) {
+  nlohmann::ordered_json j;
+  try {
+    j = to_json(YAML::Load(yaml_text));
+  } catch (const YAML::Exception& e) {
+    throw UserError(source + ": not valid YAML (" + e.msg + ")");
+  }
+  if (!j.is_object()) throw UserError(source + ": expected a mapping with teacher and params");
+  const std::string keys =
+      "teacher, params, teacher_params, expert_knowledge, success_threshold, reward_bounds, "
+      "scale_reward";
+  CurriculumSpec spec;
+  auto wrong = [&](const std::string& key, const std::string& expected) {
+    return UserError(source + ": " + key + " is " + j[key].dump() + "; expected " + expected);
+  };
+  for (const auto& [key, value] : j.items()) {
+    if (key == "teacher") {
+      if (!value.is_string()) throw wrong(key, "a teacher name");
+      spec.teacher = value.get<std::string>();
+    } else if (key == "params") {
+      try {
+        spec.space = teach::TaskSpace::from_json(value);
+      } catch (const UserError& e) {
+        throw UserError(source + ": " + e.what());
+      }
+    } else if (key == "teacher_params") {
+      if (!value.is_object()) throw wrong(key, "a mapping of the teacher's parameters");
+      spec.teacher_params = nlohmann::json::parse(value.dump());
+    } else if (key == "expert_knowledge") {
+      if (!value.is_string()) throw wrong(key, "none, low or high");
+      spec.expert_knowledge = value.get<std::string>();
+      try {
+        teach::parse_expert_knowledge(spec.expert_knowledge);
+      } catch (const UserError& e) {
+        throw UserError(source + ": " + e.what());
+      }
+    } else if (key == "success_threshold") {
+      if (!value.is_number()) throw wrong(key, "a number");
+      spec.env_options.success_threshold = value.get<double>();
+    } else if (key == "reward_bounds") {
+      if (!value.is_array() || value.size() != 2 || !value[0].is_number() ||
+          !value[1].is_number() || !(value[0].get<double>() < value[1].get<double>())) {
+        throw wrong(key, "[lb, ub] with lb < ub");
+      }
+      spec.reward_lb = value[0].get<double>();
+      spec.reward_ub = value[1].get<double>();
+    } else if (key == "scale_reward") {
+      if (!value.is_boolean()) throw wrong(key, "true or false");
+      spec.scale_reward = value.get<bool>();
+    } else {
+      throw UserError(source + ": unknown key '" + key + "' (expected " + keys + ")");
+    }
+  }
+  if (spec.teacher.empty()) throw UserError(source + ": no teacher (e.g. teacher: ALP-GMM)");
+  if (!j.contains("params")) {
+    throw UserError(source + ": no params (e.g. params: {start_posture_range: [0, 1]})");
+  }
+  return spec;
+}
+
+CurriculumSpec load_task_space(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw UserError("--task-space '" + file.string() + "' cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_task_space(text.str(), file.string());
+}
+
+std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
+                                                          std::uint64_t seed) {
+  teach::TeacherSetup setup{
+      .name = spec.teacher,
+      .mins = spec.space->mins(),
+      .maxs = spec.space->maxs(),
+      .seed = seed,
+      .expert_knowledge = teach::parse_expert_knowledge(spec.expert_knowledge),
+      .reward_lb = spec.reward_lb,
+      .reward_ub = spec.reward_ub,
+      .scale_reward = spec.scale_reward,
+      .params = spec.teacher_params};
+  return std::make_shared<teach::TeacherController>(
+      teach::make_teacher(setup), *spec.space,
+      teach::ControllerOptions{.seed = seed,
+                               .scale_reward = spec.scale_reward,
+                               .reward_lb = spec.reward_lb,
+                               .reward_ub = spec.reward_ub,
+                               .test_set = teach::default_test_set(*spec.space, 1)});
+}
+
+}  // namespace cradle::train

@@ -1,0 +1,47 @@
+// A curriculum for any env that takes its task as reset options (`cradle train --task-space`):
+// the YAML file names the teacher, the task space and the teacher's parameters (docs/curricula.md).
+//   teacher: ALP-GMM                       # one of teach::teacher_names()
+//   params:                                # name: [min, max] | [min, max, n] | [[min, max], ...]
+//     start_posture_range: [0, 1]
+//   teacher_params: {fit_rate: 50}         # the reference's kwarg names (optional)
+//   expert_knowledge: none                 # none | low | high (optional, default none)
+//   success_threshold: 100                 # optional: return above it is a success; default the
+//                                          # env's info flag is_success
+//   reward_bounds: [-100, 100]             # optional: for scale_reward and ADR's thresholds
+//   scale_reward: false                    # optional
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "teach/controller.h"
+#include "train/curriculum_env.h"
+
+namespace cradle::train {
+
+struct CurriculumSpec {
+  std::string teacher;
+  std::optional<teach::TaskSpace> space;  // set by parse_task_space
+  nlohmann::json teacher_params = nlohmann::json::object();
+  std::string expert_knowledge = "none";
+  CurriculumOptions env_options;  // the success threshold
+  double reward_lb = -100, reward_ub = 100;
+  bool scale_reward = false;
+};
+
+// Parses the YAML text (`source` names it in errors). UserError, one line, for an unknown key, a
+// missing teacher or params, malformed bounds or a value of the wrong type.
+CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source);
+CurriculumSpec load_task_space(const std::filesystem::path& file);
+
+// The controller of a spec: its teacher seeded with `seed` (UserError for an unknown teacher or
+// a bad parameter); the test set is the default one (curricula here have no evaluation of their
+// own).
+std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
+                                                          std::uint64_t seed);
+
+}  // namespace cradle::train

@@ -1,0 +1,466 @@
+#include "train/tma_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/jsonl.h"
+#include "learn/learner.h"
+#include "learn/registry.h"
+#include "learn/run_files.h"
+#include "learn/vector_env.h"
+#include "train/curriculum_env.h"
+
+namespace cradle::train {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+const char* const kProgressHeader =
+    "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,pct_mastered,"
+    "mean_train_return";
+const char* const kTestHeader = "evaluation,env_steps,task_index,return,mastered";
+// The files a checkpoint records the size of (cut back to it on resume).
+const char* const kLogs[] = {"progress.csv", "test_returns.csv", "teacher.jsonl"};
+// Arguments a resumed run may change.
+const char* const kResumable[] = {"nb_env_steps", "test_every", "resume", "out", "progress_bar"};
+
+std::string cell(double v) {
+  if (std::isnan(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string duration_text(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const long s = static_cast<long>(seconds);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  return buf;
+}
+
+// Writes `text` to `file` through a temp file and a rename (never half a file).
+void write_atomically(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw UserError("cannot write '" + tmp.string() + "'");
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw UserError("cannot write '" + file.string() + "': " + ec.message());
+}
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw UserError("--resume: cannot read '" + file.string() + "'");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception&) {
+    throw UserError("--resume: '" + file.string() + "' is not valid JSON");
+  }
+}
+
+// Cuts `file` back to `size` bytes; what follows goes to <stem>.after-checkpoint<ext>.
+void cut_back(const fs::path& file, std::uintmax_t size) {
+  std::error_code ec;
+  const std::uintmax_t now = fs::exists(file, ec) ? fs::file_size(file, ec) : 0;
+  if (now < size) {
+    throw UserError("--resume: '" + file.string() + "' is shorter than at the checkpoint (" +
+                    std::to_string(now) + " < " + std::to_string(size) + " bytes)");
+  }
+  if (now == size) return;
+  std::ifstream in(file, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(size));
+  std::ostringstream tail;
+  tail << in.rdbuf();
+  in.close();
+  const fs::path aside =
+      file.parent_path() / (file.stem().string() + ".after-checkpoint" + file.extension().string());
+  std::ofstream out(aside, std::ios::app | std::ios::binary);
+  out << tail.str();
+  if (!out.flush()) throw UserError("cannot write '" + aside.string() + "'");
+  fs::resize_file(file, size, ec);
+  if (ec) throw UserError("cannot cut '" + file.string() + "': " + ec.message());
+  std::cerr << file.filename().string() << ": lines after the checkpoint kept in " << aside.string()
+            << "\n";
+}
+
+// The teacher's build: the registry's setup from the run's options and the env's facts.
+std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const StudentRunOptions& o,
+                                                 const teach::DimensionShuffle* shuffle) {
+  teach::TeacherSetup setup{.name = o.teacher,
+                            .mins = env.space.mins(),
+                            .maxs = env.space.maxs(),
+                            .seed = o.seed,
+                            .expert_knowledge = teach::parse_expert_knowledge(o.expert_knowledge),
+                            .initial_dist = env.initial_dist,
+                            .reward_lb = env.reward_lb,
+                            .reward_ub = env.reward_ub,
+                            .scale_reward = o.scale_reward,
+                            .params = o.teacher_params};
+  // The teacher works in the shuffled space: the easy region's mean maps there.
+  if (shuffle && setup.initial_dist) {
+    setup.initial_dist->mean = shuffle->to_shuffled(setup.initial_dist->mean);
+  }
+  return teach::make_teacher(setup);
+}
+
+}  // namespace
+
+std::map<std::string, std::string> student_preset(const std::string& student, long total_steps) {
+  // SpinningUp SAC as TeachMyAgent runs it (spec §4.1).
+  if (student == "sac") {
+    return {{"pi_layers", "400,300"},
+            {"qf_layers", "400,300"},
+            {"activation", "relu"},
+            {"batch_size", "1000"},
+            {"ent_coef", "0.005"},
+            {"learning_rate", "0.001"},
+            {"buffer_size", std::to_string(std::clamp(total_steps, 1L, 2'000'000L))},
+            {"learning_starts", "10000"},
+            {"tau", "0.005"},
+            {"gamma", "0.99"},
+            {"episode_train_freq", "10"},
+            {"report_every", "1000"}};
+  }
+  // Baselines ppo2 as criterion 5 runs it (spec §4.2).
+  if (student == "ppo") {
+    return {{"pi_layers", "400,300"},    {"vf_layers", "400,300"},
+            {"activation", "tanh"},      {"ortho_init", "true"},
+            {"log_std_init", "0"},       {"n_steps", "20000"},
+            {"batch_size", "1000"},      {"n_epochs", "5"},
+            {"learning_rate", "0.0003"}, {"clip_range", "0.2"},
+            {"gae_lambda", "0.95"},      {"gamma", "0.99"},
+            {"vf_coef", "0.5"},          {"ent_coef", "0"},
+            {"max_grad_norm", "0.5"},    {"normalize_observations", "true"},
+            {"clip_observations", "10"}};
+  }
+  throw UserError("--student '" + student + "' (expected sac or ppo)");
+}
+
+StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) {
+  // Options first: nothing is written for a bad one.
+  if (o.total_steps < 1) throw UserError("--nb_env_steps must give at least 1 env step");
+  if (o.test_every < 1) throw UserError("--test_every must be at least 1");
+  if (o.nb_test_episodes < 1) throw UserError("--nb_test_episodes must be at least 1");
+  if (o.reset_frequency < 0) throw UserError("--reset_frequency must be >= 0 (0: never)");
+  if (o.out.empty()) throw UserError("--out: no run folder given");
+  std::map<std::string, std::string> hyperparameters = student_preset(o.student, o.total_steps);
+  for (const auto& [k, v] : o.hyperparameters) hyperparameters[k] = v;
+
+  const fs::path dir = o.out;
+  const fs::path checkpoints = dir / "checkpoints";
+  const fs::path latest = checkpoints / "latest.ckpt";
+  const fs::path state_file = checkpoints / "latest.json";
+  nlohmann::ordered_json run_json;
+  run_json["arguments"] = o.arguments;
+  run_json["student"] = o.student;
+  run_json["teacher"] = o.teacher;
+  run_json["teacher_params"] = o.teacher_params;
+  run_json["expert_knowledge"] = o.expert_knowledge;
+  run_json["env_steps"] = o.total_steps;
+  run_json["test_every"] = o.test_every;
+  run_json["seed"] = o.seed;
+  run_json["shuffle_dimensions"] = o.shuffle_dimensions;
+  run_json["scale_reward"] = o.scale_reward;
+  run_json["reset_frequency"] = o.reset_frequency;
+  run_json["keep_periodical_task_samples"] = o.keep_periodical_task_samples;
+  run_json["reward_bounds"] = {env.reward_lb, env.reward_ub};
+  run_json["success_threshold"] = env.success_threshold;
+  run_json["hyperparameters"] = hyperparameters;
+  run_json["bounds"] = env.space.bounds_json();
+  run_json["commit"] = o.commit;
+  run_json["cradle_version"] = CRADLE_VERSION;
+
+  // The controller: the teacher in the (maybe shuffled) space, the test set, the books.
+  std::unique_ptr<teach::DimensionShuffle> shuffle;
+  if (o.shuffle_dimensions) {
+    shuffle = std::make_unique<teach::DimensionShuffle>(env.space.mins(), env.space.maxs(), o.seed);
+  }
+  std::vector<teach::Task> test_set =
+      env.test_set.empty() ? teach::default_test_set(env.space, o.nb_test_episodes) : env.test_set;
+  auto controller = std::make_shared<teach::TeacherController>(
+      make_run_teacher(env, o, shuffle.get()), env.space,
+      teach::ControllerOptions{.seed = o.seed,
+                               .shuffle_dimensions = o.shuffle_dimensions,
+                               .scale_reward = o.scale_reward,
+                               .reward_lb = env.reward_lb,
+                               .reward_ub = env.reward_ub,
+                               .test_set = test_set,
+                               .keep_periodical_task_samples = o.keep_periodical_task_samples});
+  // The training env (one, as the reference) and a separate test env.
+  std::vector<std::unique_ptr<envs::Env>> list;
+  auto curriculum = std::make_unique<CurriculumEnv>(
+      env.make(), controller, CurriculumOptions{.success_threshold = env.success_threshold});
+  CurriculumEnv* train_env = curriculum.get();
+  list.push_back(std::move(curriculum));
+  learn::ThreadedVecEnv vec(std::move(list), 1);
+  std::unique_ptr<envs::Env> test_env = env.make();
+
+  // The student; a reset gives a fresh one (criterion 3) with its own seed.
+  long offset = 0;
+  int student_resets = 0;
+  auto make_student = [&] {
+    learn::LearnerOptions lo{.seed = o.seed + 7919 * static_cast<std::uint64_t>(student_resets),
+                             .hyperparameters = hyperparameters};
+    return learn::make_learner(o.student, vec, lo);
+  };
+  std::unique_ptr<learn::Learner> learner = make_student();
+
+  // Resume: the same arguments (but the resumable ones), the checkpoint's state.
+  nlohmann::json state;
+  if (o.resume) {
+    if (!fs::exists(latest) || !fs::exists(state_file)) {
+      throw UserError("--resume: no checkpoint in '" + checkpoints.string() + "'");
+    }
+    const nlohmann::json saved = read_json(dir / "run.json");
+    for (const auto& [key, value] : o.arguments.items()) {
+      if (std::find(std::begin(kResumable), std::end(kResumable), key) != std::end(kResumable))
+        continue;
+      const nlohmann::json before = saved["arguments"].value(key, nlohmann::json());
+      if (before != nlohmann::json::parse(value.dump())) {
+        throw UserError("--resume: --" + key + " is " + value.dump() + " but the run had " +
+                        before.dump() + " (give the run's arguments again)");
+      }
+    }
+    state = read_json(state_file);
+    if (learn::load_run_state(latest, nullptr).steps != state.value("learner_steps", -1L)) {
+      throw UserError("--resume: '" + latest.string() + "' and '" + state_file.string() +
+                      "' are of different steps");
+    }
+    for (const char* name : kLogs) cut_back(dir / name, state["sizes"][name].get<std::uintmax_t>());
+  } else {
+    fs::create_directories(checkpoints);
+  }
+  write_atomically(dir / "run.json", run_json.dump(2) + "\n");
+
+  // test_set.csv: the tasks in evaluation order.
+  {
+    std::ostringstream csv;
+    csv << "task_index";
+    for (const std::string& n : env.space.dim_names()) csv << "," << n;
+    csv << "\n";
+    for (std::size_t i = 0; i < test_set.size(); ++i) {
+      csv << i;
+      for (float v : test_set[i]) csv << "," << cell(v);
+      csv << "\n";
+    }
+    write_atomically(dir / "test_set.csv", csv.str());
+  }
+  // A resumed teacher hears the booked episodes again, in order.
+  if (o.resume) {
+    for (const nlohmann::json& line : read_jsonl(dir / "teacher.jsonl")) {
+      const std::string kind = line.value("kind", "");
+      if (kind == "train") {
+        controller->replay_train_episode(line["task"].get<teach::Task>(), line["return"],
+                                         line["length"], line["success"], line["env_steps"]);
+      } else if (kind == "periodical") {
+        controller->replay_periodical({.env_steps = line["env_steps"],
+                                       .tasks = line["tasks"].get<std::vector<teach::Task>>()});
+      }
+    }
+  }
+
+  if (o.resume) {
+    offset = state["step_offset"].get<long>();
+    student_resets = state["student_resets"].get<int>();
+    if (student_resets > 0) learner = make_student();
+    learner->load(latest);
+  }
+  auto run_steps = [&] { return offset + learner->steps(); };
+
+  // The logs: appended to on resume (already cut back), fresh otherwise.
+  std::ofstream progress(dir / "progress.csv", o.resume ? std::ios::app : std::ios::trunc);
+  std::ofstream test_csv(dir / "test_returns.csv", o.resume ? std::ios::app : std::ios::trunc);
+  if (!progress || !test_csv)
+    throw UserError("cannot write the run's logs in '" + dir.string() + "'");
+  if (!o.resume) {
+    progress << kProgressHeader << "\n";
+    test_csv << kTestHeader << "\n";
+  }
+  JsonlWriter teacher_log(dir / "teacher.jsonl", o.resume);
+
+  int evaluation = o.resume ? state["evaluation"].get<int>() + 1 : 0;
+  const double wall_before = o.resume ? state["wall_s"].get<double>() : 0.0;
+  const auto start = Clock::now();
+  const long first_steps = run_steps();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  StudentRunResult result;
+  double train_return_sum = 0;
+  long train_returns = 0;
+  // SAC's update counter (per learner; a resumed one counts from its first report).
+  double updates_done = std::nan(""), updates_seen = std::nan("");
+
+  // Booked episodes and snapshots to teacher.jsonl as they come.
+  auto drain_teacher = [&] {
+    for (const teach::EpisodeRecord& e : controller->take_episodes()) {
+      teacher_log.write({{"kind", "train"},
+                         {"episode", e.episode},
+                         {"env_steps", e.env_steps},
+                         {"task", e.task},
+                         {"return", e.ret},
+                         {"length", e.length},
+                         {"success", e.success}});
+      train_return_sum += e.ret;
+      ++train_returns;
+    }
+    for (const teach::PeriodicalRecord& p : controller->take_periodical())
+      teacher_log.write({{"kind", "periodical"}, {"env_steps", p.env_steps}, {"tasks", p.tasks}});
+  };
+
+  // One evaluation: every test task once, deterministic policy, then the files and a checkpoint.
+  std::vector<double> action(static_cast<std::size_t>(test_env->action_space().size()));
+  auto evaluate = [&] {
+    const auto eval_start = Clock::now();
+    const long steps = run_steps();
+    drain_teacher();
+    std::vector<double> returns;
+    const std::vector<std::string>& names = env.space.dim_names();
+    envs::ResetOptions task_options;
+    for (int i = 0; i < controller->test_set_size(); ++i) {
+      const teach::Task task = controller->next_test_task();
+      for (std::size_t d = 0; d < names.size(); ++d) task_options[names[d]] = task[d];
+      test_env->set_reset_options(task_options);
+      test_env->reset(o.seed * 1000003 + 100000 + static_cast<std::uint64_t>(i));
+      double ret = 0;
+      int length = 0;
+      for (;;) {
+        learner->act(test_env->observation(), action, /*deterministic=*/true);
+        const envs::StepResult r = test_env->step(action);
+        ret += r.reward;
+        ++length;
+        if (r.terminated || r.truncated) break;
+      }
+      controller->record_test_episode(ret, length);
+      returns.push_back(ret);
+      const bool mastered = ret > env.success_threshold;
+      test_csv << evaluation << "," << steps << "," << i << "," << cell(ret) << ","
+               << (mastered ? 1 : 0) << "\n";
+    }
+    double mean = 0, var = 0;
+    int mastered = 0;
+    for (double r : returns) {
+      mean += r / returns.size();
+      mastered += r > env.success_threshold;
+    }
+    for (double r : returns) var += (r - mean) * (r - mean) / returns.size();
+    const double pct = 100.0 * mastered / returns.size();
+    result.eval_s += std::chrono::duration<double>(Clock::now() - eval_start).count();
+    const double wall = wall_before + elapsed();
+    progress << evaluation << "," << steps << "," << controller->episodes() << "," << cell(wall)
+             << "," << cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << "," << cell(mean)
+             << "," << cell(std::sqrt(var)) << "," << cell(pct) << ","
+             << cell(train_returns ? train_return_sum / train_returns : std::nan("")) << "\n";
+    train_return_sum = 0;
+    train_returns = 0;
+    teacher_log.write(
+        {{"kind", "dump"}, {"env_steps", steps}, {"teacher", controller->teacher_dump()}});
+    // The checkpoint: the learner, then the state naming the logs' sizes at this point.
+    progress.flush();
+    test_csv.flush();
+    teacher_log.flush();
+    if (!progress || !test_csv)
+      throw UserError("cannot write the run's logs in '" + dir.string() + "'");
+    learn::save_run_checkpoint(latest, *learner, nullptr,
+                               {.steps = learner->steps(), .episodes = controller->episodes()});
+    nlohmann::json saved{{"env_steps", steps},
+                         {"learner_steps", learner->steps()},
+                         {"step_offset", offset},
+                         {"student_resets", student_resets},
+                         {"evaluation", evaluation},
+                         {"episodes", controller->episodes()},
+                         {"wall_s", wall}};
+    for (const char* name : kLogs) saved["sizes"][name] = fs::file_size(dir / name);
+    write_atomically(state_file, saved.dump(2) + "\n");
+    result.last_pct_mastered = pct;
+    ++result.evaluations;
+    ++evaluation;
+  };
+
+  // Evaluation 0 before training; then train to each evaluation (and student reset) in turn.
+  if (!o.resume) evaluate();
+  auto next_multiple = [&](long every) { return (run_steps() / every + 1) * every; };
+  long next_eval = next_multiple(o.test_every);
+  long next_reset = o.reset_frequency > 0 ? next_multiple(o.reset_frequency) : o.total_steps;
+  auto stopped = [&] { return o.stop && o.stop->load(); };
+  while (run_steps() < o.total_steps && !stopped()) {
+    const long target = std::min({next_eval, next_reset, o.total_steps});
+    const long before = run_steps();
+    learner->learn(target - offset, [&](const learn::TrainStats& s) {
+      const auto it = s.losses.find("updates");
+      if (it != s.losses.end()) {
+        if (std::isnan(updates_done)) updates_done = 0;
+        if (std::isnan(updates_seen)) updates_seen = o.resume ? it->second : 0;
+        updates_done += it->second - updates_seen;
+        updates_seen = it->second;
+      }
+      drain_teacher();
+      if (o.progress_bar) {
+        const long steps = offset + s.steps;
+        const double done = static_cast<double>(steps) / o.total_steps;
+        const double rate = (steps - first_steps) / std::max(elapsed(), 1e-9);
+        const int width = 30, filled = static_cast<int>(std::min(1.0, done) * width);
+        std::fprintf(stderr, "\r[%s%s] %ld/%ld steps  %.0f steps/s  ETA %s  mastered %s%% ",
+                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+                     steps, o.total_steps, rate,
+                     duration_text((o.total_steps - steps) / std::max(rate, 1e-9)).c_str(),
+                     cell(result.last_pct_mastered).c_str());
+        std::fflush(stderr);
+      }
+      return !stopped();
+    });
+    if (run_steps() == before) break;  // a learner that cannot advance
+    // A fresh student (networks, optimiser, buffer) every reset_frequency steps.
+    if (o.reset_frequency > 0 && run_steps() >= next_reset && run_steps() < o.total_steps) {
+      offset = run_steps();
+      ++student_resets;
+      learner = make_student();
+      updates_seen = 0;
+      next_reset = next_multiple(o.reset_frequency);
+    }
+    if (run_steps() >= next_eval || run_steps() >= o.total_steps) {
+      evaluate();
+      next_eval = next_multiple(o.test_every);
+    }
+  }
+  if (o.progress_bar) std::fprintf(stderr, "\n");
+  drain_teacher();
+  teacher_log.flush();
+
+  result.env_steps = run_steps();
+  result.episodes = controller->episodes();
+  result.wall_s = elapsed();
+  result.env_steps_per_s = (result.env_steps - first_steps) / std::max(result.wall_s, 1e-9);
+  result.gradient_steps = updates_done;
+  result.gradient_steps_per_s = result.gradient_steps / std::max(result.wall_s, 1e-9);
+  result.teacher_s = train_env->teacher_seconds();
+  nlohmann::ordered_json summary{
+      {"env_steps", result.env_steps},
+      {"episodes", result.episodes},
+      {"evaluations", result.evaluations},
+      {"wall_s", result.wall_s},
+      {"env_steps_per_s", result.env_steps_per_s},
+      {"gradient_steps", result.gradient_steps},
+      {"gradient_steps_per_s", result.gradient_steps_per_s},
+      {"teacher_s", result.teacher_s},
+      {"teacher_share", result.teacher_s / std::max(result.wall_s, 1e-9)},
+      {"eval_s", result.eval_s},
+      {"pct_mastered", result.last_pct_mastered}};
+  if (std::isnan(result.gradient_steps)) {
+    summary["gradient_steps"] = nullptr;
+    summary["gradient_steps_per_s"] = nullptr;
+  }
+  write_atomically(dir / "summary.json", summary.dump(2) + "\n");
+  return result;
+}
+
+}  // namespace cradle::train

@@ -1,0 +1,80 @@
+// A TeachMyAgent student run (`cradle tma run`, the reference's run.py): one learner (SAC or PPO
+// with the reference presets) trained on envs whose tasks a teacher picks, evaluated every
+// test_every env steps on a test set with the deterministic policy. The env family comes in
+// through factories, so this loop knows only envs::Env. Writes the run folder of docs/tma_run.md:
+// run.json, progress.csv, test_returns.csv, test_set.csv, teacher.jsonl, checkpoints/.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+#include "teach/controller.h"
+#include "teach/registry.h"
+
+namespace cradle::train {
+
+// What the env family brings: envs, the task space and the facts of its benchmark.
+struct StudentEnv {
+  std::function<std::unique_ptr<envs::Env>()> make;  // a fresh env (training or test)
+  teach::TaskSpace space;
+  double reward_lb = -100, reward_ub = 100;         // return bounds for reward scaling
+  double success_threshold = 230;                   // return above which a task is mastered
+  std::optional<teach::DiagGaussian> initial_dist;  // the easy region (high expert knowledge)
+  std::vector<teach::Task> test_set;                // empty: teach::default_test_set
+};
+
+struct StudentRunOptions {
+  std::string student = "sac";  // "sac" or "ppo" (the reference presets)
+  std::string teacher = "ALP-GMM";
+  nlohmann::json teacher_params = nlohmann::json::object();
+  std::string expert_knowledge = "high";  // the reference's default ("original")
+  long total_steps = 20'000'000;
+  long test_every = 500'000;  // env steps between evaluations
+  int nb_test_episodes = 100;
+  std::uint64_t seed = 0;
+  long keep_periodical_task_samples = 0;  // 0: no curriculum snapshots
+  bool shuffle_dimensions = false;
+  bool scale_reward = false;
+  long reset_frequency = 0;  // > 0: a fresh student every this many env steps (criterion 3)
+  std::map<std::string, std::string> hyperparameters;  // over the preset
+  std::filesystem::path out;
+  bool resume = false;
+  bool progress_bar = true;
+  // Written into run.json beside the parsed values (the command line's arguments as given).
+  nlohmann::ordered_json arguments = nlohmann::ordered_json::object();
+  std::string commit = "unknown";
+  const std::atomic<bool>* stop = nullptr;  // set (e.g. by Ctrl-C) to stop at the next report
+};
+
+struct StudentRunResult {
+  long env_steps = 0;
+  long episodes = 0;
+  int evaluations = 0;
+  double wall_s = 0;           // this process
+  double env_steps_per_s = 0;  // this process, evaluations included
+  double gradient_steps = 0;   // SAC: updates in this process (NaN for PPO)
+  double gradient_steps_per_s = 0;
+  double teacher_s = 0;  // time inside the teacher controller
+  double eval_s = 0;     // time evaluating
+  double last_pct_mastered = 0;
+};
+
+// The reference presets (spec tma_sami.md §4.1, §4.2) as learner hyperparameters; total_steps caps
+// SAC's replay buffer (it never overwrites within the run either way). UserError for another
+// student.
+std::map<std::string, std::string> student_preset(const std::string& student, long total_steps);
+
+// Runs (or with options.resume continues) a student run into options.out. UserError for a bad
+// option, an unknown teacher or student, or a resume whose arguments differ from run.json's.
+StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& options);
+
+}  // namespace cradle::train

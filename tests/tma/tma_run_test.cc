@@ -1,0 +1,188 @@
+// `cradle tma run`: tiny runs of both students write the run folder of docs/tma_run.md, resume
+// continues every file from the checkpoint, and bad input is a one-line error.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+CliResult cradle(const std::string& args) {
+  const std::string cmd = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
+  CliResult r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  char buf[4096];
+  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
+  r.status = WEXITSTATUS(pclose(pipe));
+  return r;
+}
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  std::string line;
+  while (std::getline(in, line)) out.push_back(line);
+  return out;
+}
+
+std::vector<std::string> cells(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string c;
+  while (std::getline(s, c, ',')) out.push_back(c);
+  return out;
+}
+
+std::vector<nlohmann::json> jsonl(const fs::path& file) {
+  std::vector<nlohmann::json> out;
+  for (const std::string& l : lines(file)) out.push_back(nlohmann::json::parse(l));
+  return out;
+}
+
+fs::path fresh(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+// Small networks, a short warm-up and 4 test tasks (the 2 x 2 grid) keep a run to seconds.
+const std::string kSac =
+    "tma run --env stump-tracks --embodiment old_classic_bipedal --student sac --seed 3 "
+    "--nb_test_episodes 4 --test_every 1000 --no-progress --hp learning_starts=300 "
+    "--hp batch_size=32 --hp pi_layers=16 --hp qf_layers=16 ";
+
+TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
+  const fs::path dir = fresh("cradle_tma_run_sac");
+  const std::string args = kSac +
+                           "--teacher ALP-GMM --teacher-param fit_rate=6 --teacher-param potential_ks=[2,3] "
+                           "--allow_expert_knowledge high --keep_periodical_task_samples 500 "
+                           "--out " +
+                           dir.string();
+  CliResult r = cradle(args + " --nb_env_steps 0.002");
+  ASSERT_EQ(r.status, 0) << r.out;
+
+  // run.json: arguments, bounds, commit, version.
+  const nlohmann::json run = nlohmann::json::parse(std::ifstream(dir / "run.json"));
+  EXPECT_EQ(run["arguments"]["teacher"], "ALP-GMM");
+  EXPECT_EQ(run["bounds"]["names"], (nlohmann::json{"stump_height", "obstacle_spacing"}));
+  EXPECT_EQ(run["bounds"]["maxs"], (nlohmann::json{3.0, 6.0}));
+  EXPECT_TRUE(run.contains("commit"));
+  EXPECT_TRUE(run.contains("cradle_version"));
+  EXPECT_EQ(run["hyperparameters"]["episode_train_freq"], "10");
+
+  // progress.csv: evaluations 0 (before training), 1 and 2.
+  std::vector<std::string> progress = lines(dir / "progress.csv");
+  ASSERT_EQ(progress.size(), 4u);
+  EXPECT_EQ(progress[0],
+            "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
+            "pct_mastered,mean_train_return");
+  EXPECT_EQ(cells(progress[1])[0], "0");
+  EXPECT_EQ(cells(progress[1])[1], "0");
+  EXPECT_EQ(cells(progress[3])[0], "2");
+  EXPECT_EQ(cells(progress[3])[1], "2000");
+  const long episodes = std::stol(cells(progress[3])[2]);
+  EXPECT_GT(episodes, 3);
+
+  // test_returns.csv: 4 tasks per evaluation; test_set.csv the 2 x 2 grid.
+  const std::vector<std::string> tests = lines(dir / "test_returns.csv");
+  ASSERT_EQ(tests.size(), 1u + 3 * 4);
+  EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
+  EXPECT_EQ(cells(tests[12])[2], "3");
+  const std::vector<std::string> set = lines(dir / "test_set.csv");
+  ASSERT_EQ(set.size(), 5u);
+  EXPECT_EQ(set[0], "task_index,stump_height,obstacle_spacing");
+  EXPECT_EQ(set[4], "3,3,6");
+
+  // teacher.jsonl: one train line per episode (in order), a dump per evaluation.
+  std::vector<nlohmann::json> book = jsonl(dir / "teacher.jsonl");
+  long train = 0, dumps = 0;
+  for (const nlohmann::json& j : book) {
+    if (j["kind"] == "train") {
+      EXPECT_EQ(j["episode"], train++);
+      EXPECT_EQ(j["task"].size(), 2u);
+      EXPECT_EQ(j["success"], j["return"].get<double>() > 230);
+    } else if (j["kind"] == "dump") {
+      ++dumps;
+      EXPECT_EQ(j["teacher"]["teacher"], "alp_gmm");
+    } else {
+      EXPECT_EQ(j["kind"], "periodical");
+      EXPECT_EQ(j["tasks"].size(), 100u);
+    }
+  }
+  EXPECT_EQ(train, episodes);
+  EXPECT_EQ(dumps, 3);
+  EXPECT_TRUE(fs::exists(dir / "checkpoints" / "latest.ckpt"));
+
+  // A row written after the checkpoint (a crash) is cut off on resume and kept aside.
+  std::ofstream(dir / "progress.csv", std::ios::app) << "9,9999,1,1,1,1,1,1,1\n";
+  r = cradle(args + " --nb_env_steps 0.003 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(lines(dir / "progress.after-checkpoint.csv").size(), 1u);
+  progress = lines(dir / "progress.csv");
+  ASSERT_EQ(progress.size(), 5u);
+  EXPECT_EQ(cells(progress[4])[0], "3");
+  EXPECT_EQ(cells(progress[4])[1], "3000");
+  EXPECT_GE(std::stol(cells(progress[4])[2]), episodes);
+  EXPECT_EQ(lines(dir / "test_returns.csv").size(), 1u + 4 * 4);
+  train = 0;
+  for (const nlohmann::json& j : jsonl(dir / "teacher.jsonl")) {
+    if (j["kind"] == "train") {
+      EXPECT_EQ(j["episode"], train++);
+    }
+  }
+  EXPECT_EQ(train, std::stol(cells(progress[4])[2]));
+
+  // Resuming with another teacher is refused.
+  r = cradle(kSac + "--teacher Random --out " + dir.string() + " --nb_env_steps 0.004 --resume");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("cradle: error: --resume: --teacher"), std::string::npos) << r.out;
+}
+
+TEST(TmaRun, PpoStudentWithStudentReset) {
+  const fs::path dir = fresh("cradle_tma_run_ppo");
+  const CliResult r = cradle(
+      "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.001 "
+      "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
+      "--hp batch_size=50 --hp pi_layers=16 --hp vf_layers=16 --out " +
+      dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::vector<std::string> progress = lines(dir / "progress.csv");
+  ASSERT_EQ(progress.size(), 4u);
+  EXPECT_EQ(cells(progress[3])[1], "1000");
+  const nlohmann::json state =
+      nlohmann::json::parse(std::ifstream(dir / "checkpoints" / "latest.json"));
+  EXPECT_EQ(state["student_resets"], 1);
+  EXPECT_EQ(state["step_offset"], 500);
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
+  EXPECT_EQ(summary["env_steps"], 1000);
+}
+
+TEST(TmaRun, BadInputIsAOneLineError) {
+  const fs::path dir = fresh("cradle_tma_run_bad");
+  for (const char* bad :
+       {"--student dqn", "--teacher Teacherless", "--teacher ADR --allow_expert_knowledge none",
+        "--allow_expert_knowledge some", "--nb_env_steps -1", "--test_set no_such_set",
+        "--embodiment tripod", "--teacher-param fit_rat=3", "--hp n_stepz=3"}) {
+    const CliResult r =
+        cradle("tma run --no-progress --out " + dir.string() + " " + std::string(bad));
+    EXPECT_EQ(r.status, 1) << bad << ": " << r.out;
+    EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << bad << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << bad << ": " << r.out;
+  }
+}
+
+}  // namespace
