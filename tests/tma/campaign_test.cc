@@ -304,6 +304,47 @@ TEST(TmaCampaign, SlurmRunsTheMiniCampaign) {
   fs::remove_all(dir);
 }
 
+// The generated lines run with the real `cradle tma run` (a tiny budget: random actions, 3 test
+// tasks) and the analysis reads its run folders: Random vs ALP-GMM on criterion 1, 2 seeds each.
+TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
+  const fs::path dir = fresh("real");
+  std::string lines;
+  for (const char* teacher : {"Random", "ALP-GMM"}) {
+    const CliResult r = cradle(std::string("tma campaign generate ") + teacher + " --teacher " +
+                               teacher + " --preset mini --steps 0.002 --test-episodes 4");
+    ASSERT_EQ(r.status, 0) << r.out;
+    for (const std::string& l : config_lines(r.out)) {
+      if (l.find("--experiment criterion_1 ") != std::string::npos &&
+          l.find("knowledge none") != std::string::npos) {
+        lines += l + "\n";
+      }
+    }
+  }
+  std::ofstream(dir / "c.txt") << lines;
+  const fs::path results = dir / "results";
+  CliResult r = cradle("tma campaign launch " + (dir / "c.txt").string() +
+                       " --local --jobs 2 --results " + results.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("4 runs finished"), std::string::npos) << r.out;
+  const fs::path run = results / "ALP-GMM_criterion_1_allow_expert_knowledge_none" /
+                       "ALP-GMM_criterion_1_allow_expert_knowledge_none_s1";
+  for (const char* f : {"run.json", "progress.csv", "test_returns.csv", "test_set.csv",
+                        "teacher.jsonl", "launch.json", "finished"}) {
+    EXPECT_TRUE(fs::exists(run / f)) << f;
+  }
+  std::ifstream in(run / "run.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["arguments"]["seed"], 1);
+  EXPECT_EQ(j["arguments"]["max_stump_h"], 9.0);
+  r = cradle("tma analyze " + results.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("4 runs, baseline Random"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(results / "analysis" / "curves_criterion_1_none.png"));
+  EXPECT_TRUE(
+      fs::exists(results / "analysis" / "curriculum_ALP-GMM_criterion_1_old_classic_bipedal.png"));
+  fs::remove_all(dir);
+}
+
 // `cradle tma video`: a run folder whose checkpoint is an (untrained) SAC student, as `cradle tma
 // run` saves it, renders test task 1 to a video; bad folders and tasks are one-line errors.
 TEST(TmaCampaign, VideoRendersTheCheckpointOnATestTask) {
