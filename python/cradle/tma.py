@@ -14,6 +14,7 @@ the TeachMyAgent README example runs with ``from cradle.tma import gym``.
 """
 
 import numbers
+import sys
 import types
 
 import numpy as np
@@ -152,3 +153,15 @@ class OldGymEnv:
 
 
 gym = types.SimpleNamespace(make=lambda env_id, **kwargs: OldGymEnv(make(env_id, **kwargs)))
+
+
+
+def __getattr__(name):
+    """`from cradle.tma import analysis`: the campaign analysis (python/cradle/tma_analysis.py),
+    imported on first use so the envs do not pull in pandas and matplotlib."""
+    if name == "analysis":
+        from . import tma_analysis
+
+        sys.modules[__name__ + ".analysis"] = tma_analysis
+        return tma_analysis
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -14,6 +14,7 @@ void register_test_installation(CLI::App& app);
 void register_train(CLI::App& app);
 void register_illustrate(CLI::App& app);
 void register_tma(CLI::App& app);
+void register_tma_campaign(CLI::App& tma);  // under `tma`: campaign, analyze
 void register_sami(CLI::App& app);
 
 }  // namespace cradle::apps

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_train(app);
   cradle::apps::register_illustrate(app);
   cradle::apps::register_tma(app);
+  cradle::apps::register_tma_campaign(*app.get_subcommand("tma"));
   cradle::apps::register_sami(app);
   try {
     app.parse(argc, argv);

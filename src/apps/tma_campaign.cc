@@ -1,0 +1,827 @@
+// `cradle tma campaign generate|launch` and `cradle tma analyze`: TeachMyAgent's benchmark
+// campaigns (many `cradle tma run` configurations × seeds) on Slurm or on a local process pool,
+// and the paper's analysis of their results tree (python/cradle/tma_analysis.py).
+//
+// Campaign file (docs/tma_campaigns.md): one configuration per line, `#` starts a comment,
+//   --seeds N[+OFFSET] --name EXP [--campaign C] [--experiment E] <cradle tma run arguments>
+// runs seeds OFFSET..OFFSET+N-1 of `cradle tma run <arguments>`; an argument written `--*key v`
+// is passed as `--key v` and appends `_key_v` to EXP (the reference's convention). Results tree:
+//   RESULTS/EXP/EXP_s<seed>/   the run folder (+ launch.json: command, commit, line; log.txt)
+//   RESULTS/EXP/launch/        the line, the commit and the sbatch script of each submission
+// A seed is finished when its folder holds done.json (written by the run) or `finished` (written
+// by the launcher after exit status 0).
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "envs/tma/tma_env.h"
+#include "eval/video.h"
+#include "learn/hyperparams.h"
+#include "learn/registry.h"
+#include "learn/vector_env.h"
+#include "tma/render.h"
+
+extern char** environ;
+
+namespace cradle::apps {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One configuration of a campaign file.
+struct CampaignLine {
+  int line_no = 0;
+  std::string text;                  // the line as written
+  std::string name;                  // experiment folder name (starred arguments appended)
+  std::string campaign, experiment;  // analysis labels
+  int seeds = 0, offset = 0;         // seeds offset .. offset + seeds - 1
+  std::vector<std::string> args;     // `cradle tma run` arguments, stars removed
+};
+
+// Arguments the launcher sets itself for every seed.
+const std::set<std::string> kLauncherArgs = {"--seed", "--out", "--resume", "--exp_name"};
+
+// Names become folder names: no separators, spaces or shell characters.
+bool valid_name(const std::string& s) {
+  if (s.empty()) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
+           c == '+';
+  });
+}
+
+int parse_count(const std::string& text, const std::string& what, int min) {
+  try {
+    size_t used = 0;
+    const int v = std::stoi(text, &used);
+    if (used == text.size() && v >= min) return v;
+  } catch (const std::exception&) {
+  }
+  throw UserError(what + " '" + text + "' (expected an integer >= " + std::to_string(min) + ")");
+}
+
+std::vector<std::string> split_words(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+// One non-comment line -> a configuration; `where` names it in errors.
+CampaignLine parse_line(const std::string& text, const std::string& where) {
+  CampaignLine line;
+  line.text = text;
+  const std::vector<std::string> words = split_words(text);
+  std::string suffix;
+  bool has_seeds = false;
+  for (size_t i = 0; i < words.size(); ++i) {
+    const std::string& w = words[i];
+    const bool has_value = i + 1 < words.size() && words[i + 1].rfind("--", 0) != 0;
+    // Campaign keys: consumed here, never passed to the run.
+    if (w == "--seeds" || w == "--name" || w == "--campaign" || w == "--experiment") {
+      if (!has_value) throw UserError(where + ": " + w + " needs a value");
+      const std::string& v = words[++i];
+      if (w == "--seeds") {
+        const size_t plus = v.find('+');
+        line.seeds = parse_count(v.substr(0, plus), where + ": --seeds", 1);
+        if (plus != std::string::npos) {
+          line.offset = parse_count(v.substr(plus + 1), where + ": --seeds offset", 0);
+        }
+        has_seeds = true;
+      } else if (!valid_name(v)) {
+        throw UserError(where + ": " + w + " '" + v + "' (expected letters, digits, _ - . +)");
+      } else {
+        (w == "--name" ? line.name : w == "--campaign" ? line.campaign : line.experiment) = v;
+      }
+      continue;
+    }
+    if (w.rfind("--", 0) != 0) {
+      if (line.args.empty()) throw UserError(where + ": '" + w + "' is not a --flag");
+      line.args.push_back(w);
+      continue;
+    }
+    // A starred argument names the experiment too.
+    const bool starred = w.rfind("--*", 0) == 0;
+    const std::string flag = starred ? "--" + w.substr(3) : w;
+    if (flag.size() <= 2) throw UserError(where + ": '" + w + "' is not a --flag");
+    if (kLauncherArgs.count(flag)) {
+      throw UserError(where + ": " + flag + " is set by the launcher for every seed (remove it)");
+    }
+    line.args.push_back(flag);
+    if (starred) {
+      suffix += "_" + flag.substr(2);
+      if (has_value) suffix += "_" + words[i + 1];
+    }
+  }
+  if (!has_seeds) throw UserError(where + ": no --seeds N[+OFFSET]");
+  if (line.name.empty()) throw UserError(where + ": no --name EXP");
+  line.name += suffix;
+  if (!valid_name(line.name)) {
+    throw UserError(where + ": experiment name '" + line.name + "' is not a folder name");
+  }
+  if (line.experiment.empty()) line.experiment = line.name;
+  if (line.campaign.empty()) line.campaign = line.name;
+  return line;
+}
+
+std::vector<CampaignLine> read_campaign(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw UserError("cannot read campaign file " + file.string());
+  std::vector<CampaignLine> lines;
+  std::set<std::string> names;
+  std::string text;
+  for (int n = 1; std::getline(in, text); ++n) {
+    const size_t hash = text.find('#');
+    const std::string body = text.substr(0, hash);
+    if (split_words(body).empty()) continue;
+    const std::string where = file.string() + ":" + std::to_string(n);
+    CampaignLine line = parse_line(body, where);
+    line.line_no = n;
+    if (!names.insert(line.name).second) {
+      throw UserError(where + ": experiment '" + line.name + "' appears twice (names must differ)");
+    }
+    lines.push_back(std::move(line));
+  }
+  if (lines.empty()) throw UserError("campaign file " + file.string() + " has no configuration");
+  return lines;
+}
+
+// ---- generate ------------------------------------------------------------------------------
+
+struct GenerateOptions {
+  std::string name, teacher, preset = "paper", out;
+  std::vector<std::string> teacher_params;
+  double steps = 0;        // millions; 0: the preset's
+  int seeds = 0;           // 0: the preset's
+  int test_episodes = -1;  // 0: the named test sets (paper); N: N default test tasks; -1: preset's
+};
+
+// Teachers that refuse to run without expert knowledge (spec §1.3).
+const std::set<std::string> kNeedExpertKnowledge = {"ADR", "GoalGAN", "Setter-Solver"};
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Every configuration of both experiments for one teacher (spec §4.3, §5).
+std::string generate(const GenerateOptions& o) {
+  if (o.preset != "paper" && o.preset != "mini") {
+    throw UserError("--preset '" + o.preset + "' (expected paper or mini)");
+  }
+  if (!valid_name(o.name)) {
+    throw UserError("campaign name '" + o.name + "' (expected letters, digits, _ - . +)");
+  }
+  if (o.teacher.empty() || o.teacher.find_first_of(" \t") != std::string::npos) {
+    throw UserError("--teacher '" + o.teacher + "' (expected a teacher name, e.g. ALP-GMM)");
+  }
+  for (const std::string& p : o.teacher_params) {
+    const size_t eq = p.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == p.size() ||
+        p.find_first_of(" \t#") != std::string::npos) {
+      throw UserError("--teacher-param '" + p + "' (expected key=value without spaces)");
+    }
+  }
+  const bool paper = o.preset == "paper";
+  const double steps = o.steps > 0 ? o.steps : (paper ? 20.0 : 0.02);
+  const int seeds = o.seeds > 0 ? o.seeds : (paper ? 16 : 2);
+  const int test_episodes = o.test_episodes >= 0 ? o.test_episodes : (paper ? 0 : 10);
+  // Paper: 40 evaluations (every 500 k steps at 20 M); mini: 2.
+  const long test_every = std::max(1L, std::lround(steps * 1e6 / (paper ? 40 : 2)));
+  const long periodical = std::max(1L, test_every / 2);
+  const bool is_adr = o.teacher == "ADR";
+  const bool is_random = o.teacher == "Random";
+
+  std::string teacher_args = "--teacher " + o.teacher;
+  for (const std::string& p : o.teacher_params) teacher_args += " --teacher-param " + p;
+  const std::string budget = "--nb_env_steps " + number(steps) + " --test_every " +
+                             std::to_string(test_every) + " --keep_periodical_task_samples " +
+                             std::to_string(periodical);
+  // The reference's test sets (100 tasks each), or N tasks of the default set (cheaper).
+  const auto test_set = [&](const std::string& name) {
+    return test_episodes == 0 ? "--test_set " + name
+                              : "--nb_test_episodes " + std::to_string(test_episodes);
+  };
+  const std::string stumps = "--env stump-tracks " + test_set("parametric_stumps_test_set");
+
+  std::ostringstream f;
+  f << "# cradle tma campaign: " << o.name << " (teacher " << o.teacher << ", preset " << o.preset
+    << ", " << number(steps) << " M steps, " << seeds << " seeds)\n"
+    << "# Each line: --seeds N[+OFFSET] --name EXP [--campaign C] [--experiment E] <cradle tma "
+       "run args>\n"
+    << "# `--*key v` passes --key v and appends _key_v to EXP. See docs/tma_campaigns.md.\n";
+  auto line = [&](int n, const std::string& offset, const std::string& experiment,
+                  const std::string& args) {
+    f << "--seeds " << n << offset << " --campaign " << o.name << " --experiment " << experiment
+      << " --name " << o.name << "_" << experiment << " " << args << " " << teacher_args << " "
+      << budget << "\n";
+  };
+  // Random's runs are duplicated into every EK level by the analysis: only its "none" block.
+  std::vector<std::string> levels = {"none", "low", "high"};
+  if (is_random) levels = {"none"};
+  if (kNeedExpertKnowledge.count(o.teacher)) levels = {"low", "high"};
+  f << "#### Skill-specific comparison: Stump Tracks, criteria 1-5\n";
+  for (const std::string& ek : levels) {
+    const int n = is_adr ? 2 * seeds : seeds;
+    const std::string bipedal = stumps + " --embodiment old_classic_bipedal --student sac";
+    const std::string ek_arg = "--*allow_expert_knowledge " + ek;
+    f << "## " << ek << " expert knowledge\n# Criterion 1: mostly unfeasible task space\n";
+    line(n, "", "criterion_1", bipedal + " --max_stump_h 9 --max_obstacle_spacing 6 " + ek_arg);
+    f << "# Criterion 2: mostly trivial task space\n";
+    line(n, "", "criterion_2",
+         bipedal + " --min_stump_h -3 --max_stump_h 3 --max_obstacle_spacing 6 " + ek_arg);
+    f << "# Criterion 3: a student that forgets (reset every 7 M of 20 M steps)\n";
+    line(n, "", "criterion_3",
+         bipedal + " --max_stump_h 3 --max_obstacle_spacing 6 --reset_frequency " +
+             std::to_string(std::lround(steps * 1e6 * 7 / 20)) + " " + ek_arg);
+    f << "# Criterion 4: rugged difficulty (dimension shuffling)\n";
+    line(n, "", "criterion_4",
+         bipedal + " --max_stump_h 3 --max_obstacle_spacing 6 --shuffle_dimensions " + ek_arg);
+    f << "# Criterion 5: a variety of students ({spider, small_bipedal} x {SAC, PPO})\n";
+    const int n5 = is_adr && ek != "high" ? 2 * seeds : seeds;
+    for (const char* student : {"sac", "ppo"}) {
+      for (const char* body : {"spider", "small_bipedal"}) {
+        line(n5, "", "criterion_5",
+             stumps + " --max_stump_h 3 --max_obstacle_spacing 6 --*embodiment " + body +
+                 " --*student " + student + (std::string(student) == "ppo" ? " --lr 0.0003" : "") +
+                 " " + ek_arg);
+      }
+    }
+  }
+  f << "#### Global performance: Parkour, three embodiments with distinct seeds, low EK\n";
+  const std::string parkour = "--env parkour --student sac --allow_expert_knowledge low";
+  line(seeds, "", "parkour",
+       parkour + " --*embodiment old_classic_bipedal " + test_set("walking_test_set_v1"));
+  line(seeds, "+" + std::to_string(seeds), "parkour",
+       parkour + " --*embodiment climbing_profile_chimpanzee " + test_set("climbing_test_set_v1"));
+  line(seeds, "+" + std::to_string(2 * seeds), "parkour",
+       parkour + " --*embodiment fish " + test_set("swimming_test_set_v1"));
+  f << "#### Upper baseline: the plain [0, 3] x [0, 6] space\n";
+  for (const std::string& ek : levels) {
+    line(2 * seeds, "", "upper_baseline",
+         stumps +
+             " --embodiment old_classic_bipedal --student sac --max_stump_h 3 "
+             "--max_obstacle_spacing 6 --*allow_expert_knowledge " +
+             ek);
+  }
+  return f.str();
+}
+
+// ---- launch --------------------------------------------------------------------------------
+
+struct LaunchOptions {
+  std::string file, results = "tma_results", runner;
+  std::vector<std::string> sbatch_args;
+  int jobs = 1, seeds_per_job = 8;
+  bool dry_run = false, resume = false, local = false, slurm = false, wait = false;
+};
+
+// One seed of one configuration.
+struct SeedRun {
+  const CampaignLine* line = nullptr;
+  int seed = 0;
+  fs::path dir;
+};
+
+// The run's own done.json or the launcher's marker after exit status 0.
+bool finished(const fs::path& dir) {
+  return fs::exists(dir / "done.json") || fs::exists(dir / "finished");
+}
+
+// A word for bash: as is when plain, else single-quoted.
+std::string quote(const std::string& s) {
+  const bool plain = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) ||
+           std::string("_-./+=:,").find(c) != std::string::npos;
+  });
+  if (plain) return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string join_quoted(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : " ") + quote(w);
+  return out;
+}
+
+// Output of a shell command (stdout and stderr) and whether it exited with status 0.
+std::pair<bool, std::string> capture(const std::string& command) {
+  std::string out;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return {false, out};
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) out.append(buf, n);
+  const bool ok = ::pclose(pipe) == 0;
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return {ok, out};
+}
+
+// The last line of a command's output, for a one-line error.
+std::string last_line(const std::string& text) {
+  const size_t nl = text.rfind('\n');
+  return nl == std::string::npos ? text : text.substr(nl + 1);
+}
+
+bool on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return false;
+  std::stringstream dirs(path);
+  for (std::string d; std::getline(dirs, d, ':');) {
+    if (!d.empty() && ::access((fs::path(d) / program).c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+// The command that runs one seed of one run, without --seed/--out/--resume.
+std::vector<std::string> run_prefix(const LaunchOptions& o, const CampaignLine& line) {
+  std::vector<std::string> argv;
+  if (o.runner.empty()) {
+    argv = {fs::read_symlink("/proc/self/exe").string(), "tma", "run"};
+  } else {
+    argv = split_words(o.runner);
+    if (argv.empty()) throw UserError("--runner is empty (expected a command)");
+  }
+  argv.insert(argv.end(), line.args.begin(), line.args.end());
+  argv.push_back("--exp_name");
+  argv.push_back(line.name);
+  return argv;
+}
+
+std::vector<std::string> seed_command(const LaunchOptions& o, const SeedRun& r, bool resume) {
+  std::vector<std::string> argv = run_prefix(o, *r.line);
+  argv.insert(argv.end(), {"--seed", std::to_string(r.seed), "--out", r.dir.string()});
+  if (resume) argv.push_back("--resume");
+  return argv;
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file);
+  out << text;
+  if (!out) throw UserError("cannot write " + file.string());
+}
+
+// Records how a seed is run beside its results (the reference's copy of script and git log).
+void write_launch_json(const LaunchOptions& o, const SeedRun& r, const std::string& commit) {
+  fs::create_directories(r.dir);
+  const nlohmann::json j = {{"campaign", r.line->campaign},
+                            {"experiment", r.line->experiment},
+                            {"name", r.line->name},
+                            {"seed", r.seed},
+                            {"args", r.line->args},
+                            {"command", seed_command(o, r, false)},
+                            {"commit", commit},
+                            {"cradle_version", CRADLE_VERSION},
+                            {"campaign_file", fs::absolute(o.file).string()},
+                            {"campaign_line", r.line->line_no},
+                            {"line", r.line->text}};
+  write_text(r.dir / "launch.json", j.dump(1) + "\n");
+}
+
+// The finished marker (when the run wrote no done.json of its own).
+void mark_finished(const fs::path& dir, double wall_s) {
+  if (fs::exists(dir / "done.json")) return;
+  write_text(dir / "finished",
+             nlohmann::json{{"exit_status", 0}, {"wall_s", wall_s}}.dump() + "\n");
+}
+
+// Local process pool: at most `jobs` seeds at once, each logging to its folder's log.txt.
+int launch_local(const LaunchOptions& o, const std::vector<SeedRun>& runs) {
+  using Clock = std::chrono::steady_clock;
+  struct Running {
+    const SeedRun* run;
+    Clock::time_point start;
+  };
+  std::map<pid_t, Running> running;
+  size_t next = 0, done = 0;
+  std::vector<std::string> failures;
+  while (next < runs.size() || !running.empty()) {
+    // Fill the pool.
+    while (next < runs.size() && static_cast<int>(running.size()) < o.jobs) {
+      const SeedRun& r = runs[next++];
+      const bool resume = fs::exists(r.dir / "run.json");
+      const std::vector<std::string> argv = seed_command(o, r, resume);
+      std::vector<char*> cargv;
+      for (const std::string& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
+      cargv.push_back(nullptr);
+      posix_spawn_file_actions_t actions;
+      posix_spawn_file_actions_init(&actions);
+      const std::string log = (r.dir / "log.txt").string();
+      posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND,
+                                       0644);
+      posix_spawn_file_actions_adddup2(&actions, 1, 2);
+      pid_t pid = 0;
+      const int err = posix_spawnp(&pid, cargv[0], &actions, nullptr, cargv.data(), environ);
+      posix_spawn_file_actions_destroy(&actions);
+      if (err != 0) throw UserError("cannot start '" + argv[0] + "' (expected a program)");
+      running[pid] = {&r, Clock::now()};
+    }
+    // Reap one.
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, 0);
+    if (pid < 0) break;
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const SeedRun& r = *it->second.run;
+    const double wall = std::chrono::duration<double>(Clock::now() - it->second.start).count();
+    running.erase(it);
+    ++done;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (code == 0) {
+      mark_finished(r.dir, wall);
+      std::printf("[%zu/%zu] %s seed %d finished in %.1f s\n", done, runs.size(),
+                  r.line->name.c_str(), r.seed, wall);
+    } else {
+      failures.push_back(r.line->name + " seed " + std::to_string(r.seed) + " (exit " +
+                         std::to_string(code) + ", log " + (r.dir / "log.txt").string() + ")");
+      std::printf("[%zu/%zu] %s seed %d FAILED (exit %d)\n", done, runs.size(),
+                  r.line->name.c_str(), r.seed, code);
+    }
+    std::fflush(stdout);
+  }
+  for (const std::string& f : failures) std::fprintf(stderr, "failed: %s\n", f.c_str());
+  if (!failures.empty()) {
+    throw UserError(std::to_string(failures.size()) + " of " + std::to_string(runs.size()) +
+                    " runs failed; fix them and launch again with --resume");
+  }
+  std::printf("%zu runs finished under %s\n", runs.size(), o.results.c_str());
+  return 0;
+}
+
+// The sbatch script of one line: an array task runs `seeds_per_job` seeds, each pinned to one of
+// the task's cores, and skips the seeds already finished.
+std::string sbatch_script(const LaunchOptions& o, const CampaignLine& line,
+                          const std::string& indices, const fs::path& exp_dir) {
+  const int k = o.seeds_per_job;
+  const std::string seed_dir = (exp_dir / (line.name + "_s")).string();
+  std::ostringstream s;
+  s << "#!/bin/bash\n"
+    << "#SBATCH --job-name=" << line.name << "\n"
+    << "#SBATCH --array=" << indices << "\n"
+    << "#SBATCH --ntasks=1\n"
+    << "#SBATCH --cpus-per-task=" << std::min(k, line.seeds) << "\n"
+    << "#SBATCH --output=" << (exp_dir / "launch" / "slurm_%A_%a.out").string() << "\n";
+  for (const std::string& a : o.sbatch_args) s << "#SBATCH " << a << "\n";
+  s << "# " << line.name << ": seeds " << line.offset << ".." << line.offset + line.seeds - 1
+    << ", " << k << " per array task (cradle tma campaign launch)\n"
+    << "set -u\n"
+    << "first=$((" << line.offset << " + SLURM_ARRAY_TASK_ID * " << k << "))\n"
+    << "last=$((first + " << k << " - 1))\n"
+    << "[ $last -gt " << line.offset + line.seeds - 1
+    << " ] && last=" << line.offset + line.seeds - 1 << "\n"
+    << "# The cores this task may use, one per seed.\n"
+    << "cpus=()\n"
+    << "for r in $(taskset -cp $$ | sed 's/.*: //' | tr ',' ' '); do\n"
+    << "  for ((c = ${r%-*}; c <= ${r#*-}; c++)); do cpus+=($c); done\n"
+    << "done\n"
+    << "pids=()\n"
+    << "slot=0\n"
+    << "for seed in $(seq $first $last); do\n"
+    << "  dir=" << quote(seed_dir) << "$seed\n"
+    << "  [ -e \"$dir/done.json\" ] || [ -e \"$dir/finished\" ] && continue\n"
+    << "  mkdir -p \"$dir\"\n"
+    << "  resume=; [ -e \"$dir/run.json\" ] && resume=--resume\n"
+    << "  cpu=${cpus[$((slot % ${#cpus[@]}))]}\n"
+    << "  slot=$((slot + 1))\n"
+    << "  (\n"
+    << "    start=$(date +%s)\n"
+    << "    taskset -c \"$cpu\" " << join_quoted(run_prefix(o, line))
+    << " --seed \"$seed\" --out \"$dir\" $resume >> \"$dir/log.txt\" 2>&1 || exit $?\n"
+    << "    [ -e \"$dir/done.json\" ] || echo \"{\\\"exit_status\\\": 0, \\\"wall_s\\\": "
+       "$(($(date +%s) - start))}\" > \"$dir/finished\"\n"
+    << "  ) &\n"
+    << "  pids+=($!)\n"
+    << "done\n"
+    << "status=0\n"
+    << "for p in \"${pids[@]}\"; do wait \"$p\" || status=1; done\n"
+    << "exit $status\n";
+  return s.str();
+}
+
+// Array indices "0,2-3" of the blocks that still hold an unfinished seed.
+std::string array_indices(const std::vector<int>& blocks) {
+  std::string out;
+  for (size_t i = 0; i < blocks.size();) {
+    size_t j = i;
+    while (j + 1 < blocks.size() && blocks[j + 1] == blocks[j] + 1) ++j;
+    out += (out.empty() ? "" : ",") + std::to_string(blocks[i]) +
+           (j > i ? "-" + std::to_string(blocks[j]) : "");
+    i = j + 1;
+  }
+  return out;
+}
+
+int launch_slurm(const LaunchOptions& o, const std::vector<CampaignLine>& lines,
+                 const std::vector<SeedRun>& runs, const std::string& commit) {
+  std::vector<std::string> job_ids;
+  for (const CampaignLine& line : lines) {
+    std::set<int> block_set;
+    for (const SeedRun& r : runs) {
+      if (r.line == &line) block_set.insert((r.seed - line.offset) / o.seeds_per_job);
+    }
+    if (block_set.empty()) continue;
+    const fs::path exp_dir = fs::path(o.results) / line.name;
+    const std::string indices = array_indices({block_set.begin(), block_set.end()});
+    const std::string script = sbatch_script(o, line, indices, fs::absolute(exp_dir));
+    if (o.dry_run) {
+      std::printf("#### %s (%zu array tasks)\n%s\n", line.name.c_str(), block_set.size(),
+                  script.c_str());
+      continue;
+    }
+    const fs::path launch_dir = exp_dir / "launch";
+    fs::create_directories(launch_dir);
+    write_text(launch_dir / "line.txt", line.text + "\n");
+    write_text(launch_dir / "commit.txt", commit + "\n");
+    const fs::path script_file = launch_dir / (line.name + ".sbatch");
+    write_text(script_file, script);
+    const auto [ok, id] = capture("sbatch --parsable " + quote(script_file.string()));
+    if (!ok || id.empty()) {
+      throw UserError("sbatch refused " + script_file.string() + " (" + last_line(id) +
+                      "); is Slurm up? (scripts/slurm-local.sh, or --local)");
+    }
+    const std::string job = last_line(id).substr(0, last_line(id).find(';'));
+    job_ids.push_back(job);
+    std::printf("submitted %s: job %s, array %s\n", line.name.c_str(), job.c_str(),
+                indices.c_str());
+    std::fflush(stdout);
+  }
+  if (o.dry_run || !o.wait || job_ids.empty()) return 0;
+  // --wait: until squeue lists none of our jobs, then count the finished seeds.
+  std::string list;
+  for (const std::string& j : job_ids) list += (list.empty() ? "" : ",") + j;
+  for (;;) {
+    const auto [ok, queued] = capture("squeue -h -o %i -j " + list);
+    if (!ok || queued.empty()) break;
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+  }
+  size_t ok = 0;
+  for (const SeedRun& r : runs) ok += finished(r.dir) ? 1 : 0;
+  std::printf("%zu of %zu runs finished under %s\n", ok, runs.size(), o.results.c_str());
+  if (ok != runs.size()) {
+    throw UserError(std::to_string(runs.size() - ok) +
+                    " runs did not finish (see their log.txt); launch again with --resume");
+  }
+  return 0;
+}
+
+int launch(const LaunchOptions& o) {
+  if (o.jobs < 1) throw UserError("--jobs must be >= 1");
+  if (o.local && o.slurm) throw UserError("--local and --slurm exclude each other");
+  const std::vector<CampaignLine> lines = read_campaign(o.file);
+  const bool slurm = o.slurm || (!o.local && on_path("sbatch"));
+  if (o.slurm && !o.dry_run && !on_path("sbatch")) {
+    throw UserError("--slurm: sbatch is not on the PATH (start scripts/slurm-local.sh or drop it)");
+  }
+  // The seeds to run: every seed, less the finished ones under --resume.
+  std::vector<SeedRun> runs;
+  size_t skipped = 0;
+  for (const CampaignLine& line : lines) {
+    for (int s = line.offset; s < line.offset + line.seeds; ++s) {
+      SeedRun r{&line, s, fs::path(o.results) / line.name / (line.name + "_s" + std::to_string(s))};
+      if (fs::exists(r.dir) && !o.resume && !o.dry_run) {
+        throw UserError(r.dir.string() + " exists (use --resume to continue the campaign)");
+      }
+      if (o.resume && finished(r.dir)) {
+        ++skipped;
+        continue;
+      }
+      runs.push_back(r);
+    }
+  }
+  if (skipped) std::printf("--resume: %zu finished seeds skipped\n", skipped);
+  const std::string commit = [] {
+    const auto [ok, c] = capture("git -C " + quote(CRADLE_SOURCE_DIR) + " rev-parse HEAD");
+    return ok && !c.empty() ? c : std::string("unknown");
+  }();
+  if (!o.dry_run) {
+    for (const SeedRun& r : runs) write_launch_json(o, r, commit);
+  }
+  if (slurm) return launch_slurm(o, lines, runs, commit);
+  if (o.dry_run) {
+    for (const SeedRun& r : runs) {
+      std::printf("%s\n", join_quoted(seed_command(o, r, fs::exists(r.dir / "run.json"))).c_str());
+    }
+    return 0;
+  }
+  return launch_local(o, runs);
+}
+
+// ---- analyze -------------------------------------------------------------------------------
+
+int analyze(const std::string& results, const std::string& out, const std::string& baseline) {
+  if (!fs::is_directory(results)) {
+    throw UserError("results folder " + results + " does not exist (expected a campaign's tree)");
+  }
+  const char* env_python = std::getenv("CRADLE_PYTHON");
+  const std::string python = env_python && *env_python ? env_python : CRADLE_PYTHON;
+  const std::string script = std::string(CRADLE_PYTHON_DIR) + "/cradle/tma_analysis.py";
+  std::vector<std::string> argv = {python, script, results, "--out", out};
+  if (!baseline.empty()) argv.insert(argv.end(), {"--baseline", baseline});
+  std::vector<char*> cargv;
+  for (const std::string& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
+  cargv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, python.c_str(), nullptr, nullptr, cargv.data(), environ) != 0) {
+    throw UserError("cannot start " + python +
+                    " (expected Python 3 with matplotlib, scipy, pandas)");
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  if (code != 0)
+    throw UserError("the analysis failed (" + script + " exit " + std::to_string(code) + ")");
+  return 0;
+}
+
+// ---- video ---------------------------------------------------------------------------------
+
+struct VideoOptions {
+  std::string run, out;
+  int test_task = 0, steps = 2000;
+  std::uint64_t seed = 0;
+  bool lidars = false;
+};
+
+// Row K of a run's test_set.csv as reset options (header task_index,<names...>).
+envs::ResetOptions test_task(const fs::path& file, int k) {
+  std::ifstream in(file);
+  if (!in)
+    throw UserError("cannot read " + file.string() + " (expected a `cradle tma run` folder)");
+  std::string header, row;
+  std::getline(in, header);
+  std::vector<std::string> names;
+  std::stringstream h(header);
+  for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  int rows = 0;
+  while (std::getline(in, row)) {
+    std::stringstream r(row);
+    std::string cell;
+    std::getline(r, cell, ',');
+    if (cell != std::to_string(k)) {
+      ++rows;
+      continue;
+    }
+    envs::ResetOptions task;
+    for (size_t i = 1; i < names.size() && std::getline(r, cell, ','); ++i) {
+      task[names[i]] = std::stod(cell);
+    }
+    return task;
+  }
+  throw UserError("--test-task " + std::to_string(k) + " (expected 0.." + std::to_string(rows - 1) +
+                  " of " + file.string() + ")");
+}
+
+// One deterministic episode of the run's latest checkpoint on test task K, rendered to a video.
+void video(const VideoOptions& o) {
+  const fs::path dir = o.run;
+  std::ifstream run_file(dir / "run.json");
+  if (!run_file) throw UserError("no run.json in " + dir.string() + " (expected a run folder)");
+  nlohmann::json run;
+  try {
+    run = nlohmann::json::parse(run_file);
+  } catch (const std::exception&) {
+    throw UserError((dir / "run.json").string() + " is not JSON");
+  }
+  const nlohmann::json args = run.value("arguments", nlohmann::json::object());
+  const std::string env_name = args.value("env", std::string("stump-tracks"));
+  const std::string body = args.value("embodiment", std::string("old_classic_bipedal"));
+  const envs::ResetOptions task = test_task(dir / "test_set.csv", o.test_task);
+  const fs::path ckpt = dir / "checkpoints" / "latest.ckpt";
+  if (!fs::exists(ckpt)) throw UserError("no checkpoint " + ckpt.string() + " (train first)");
+
+  // The learner as saved (its own hyperparameters; no replay memory needed to act).
+  const learn::CheckpointInfo info = learn::read_checkpoint_info(ckpt);
+  learn::LearnerOptions lo;
+  lo.hyperparameters = learn::parse_hyperparameter_text(info.config);
+  if (lo.hyperparameters.count("buffer_size")) lo.hyperparameters["buffer_size"] = "1000";
+  const tma::TmaOptions options{
+      .env = tma::parse_env_id(env_name), .body = body, .max_episode_steps = o.steps};
+  learn::ThreadedVecEnv vec(
+      1, [&](int) { return std::make_unique<envs::TmaEnvAdapter>(options); }, 1);
+  std::unique_ptr<learn::Learner> learner = learn::make_learner(info.algorithm, vec, lo);
+  learner->load(ckpt);
+
+  envs::TmaEnvAdapter env(options);
+  env.set_reset_options(task);
+  env.reset(o.seed);
+  const std::string out =
+      o.out.empty() ? (dir / ("test_task_" + std::to_string(o.test_task) + ".mp4")).string()
+                    : o.out;
+  const int w = 600, h = 400;
+  eval::VideoWriter writer(out, w, h, tma::kFps);
+  std::vector<std::uint8_t> frame;
+  std::vector<double> action(env.action_space().size());
+  double ret = 0;
+  int length = 0;
+  for (bool done = false; !done;) {
+    tma::render(env.env(), w, h, o.lidars, frame);
+    writer.write(frame);
+    learner->act(env.observation(), action, /*deterministic=*/true);
+    const envs::StepResult r = env.step(action);
+    ret += r.reward;
+    ++length;
+    done = r.terminated || r.truncated;
+  }
+  tma::render(env.env(), w, h, o.lidars, frame);
+  writer.write(frame);
+  writer.close();
+  std::printf("test task %d: return %.1f in %d steps (%s) after %ld training steps -> %s\n",
+              o.test_task, ret, length, ret > 230 ? "mastered" : "not mastered", info.steps,
+              out.c_str());
+}
+
+}  // namespace
+
+void register_tma_campaign(CLI::App& tma) {
+  CLI::App* campaign = tma.add_subcommand("campaign", "TeachMyAgent benchmark campaigns");
+  campaign->require_subcommand(1);
+
+  auto go = std::make_shared<GenerateOptions>();
+  CLI::App* gen = campaign->add_subcommand("generate", "Write the campaign file of one teacher");
+  gen->add_option("NAME", go->name, "Campaign name (prefix of every experiment)")->required();
+  gen->add_option("--teacher", go->teacher, "Teacher (Random, ADR, ALP-GMM, RIAC, ...)")
+      ->required();
+  gen->add_option("--teacher-param", go->teacher_params, "Teacher parameter key=value");
+  gen->add_option("--test-episodes", go->test_episodes,
+                  "0: the reference's test sets (paper); N: N default test tasks (mini 10)")
+      ->check(CLI::Range(0, 100000));
+  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.02)")
+      ->check(CLI::PositiveNumber);
+  gen->add_option("--seeds", go->seeds, "Seeds per configuration (paper 16, mini 2)")
+      ->check(CLI::Range(1, 100000));
+  gen->add_option("--preset", go->preset, "paper | mini");
+  gen->add_option("--out", go->out, "Write here (default: stdout)");
+  gen->callback([go] {
+    const std::string text = generate(*go);
+    if (go->out.empty()) {
+      std::fputs(text.c_str(), stdout);
+    } else {
+      write_text(go->out, text);
+      std::printf("wrote %s\n", go->out.c_str());
+    }
+  });
+
+  auto lo = std::make_shared<LaunchOptions>();
+  CLI::App* lau = campaign->add_subcommand("launch", "Run a campaign file (Slurm or locally)");
+  lau->add_option("FILE", lo->file, "Campaign file")->required();
+  lau->add_option("--results", lo->results, "Results tree (default tma_results)");
+  lau->add_option("--jobs", lo->jobs, "Local: runs at once");
+  lau->add_flag("--dry-run", lo->dry_run, "Print the sbatch scripts (or local commands) only");
+  lau->add_flag("--resume", lo->resume, "Skip finished seeds, continue the others");
+  lau->add_flag("--local", lo->local, "Local process pool even where sbatch exists");
+  lau->add_flag("--slurm", lo->slurm, "Slurm (an error where sbatch is missing, but --dry-run)");
+  lau->add_option("--seeds-per-job", lo->seeds_per_job, "Slurm: seeds per array task (8)")
+      ->check(CLI::Range(1, 1024));
+  lau->add_option("--sbatch", lo->sbatch_args, "Slurm: extra #SBATCH line, e.g. --time=20:00:00");
+  lau->add_flag("--wait", lo->wait, "Slurm: wait until every job has left the queue");
+  lau->add_option("--runner", lo->runner, "Command of one run (default: this cradle's `tma run`)");
+  lau->callback([lo] { launch(*lo); });
+
+  struct AnalyzeOptions {
+    std::string results, out, baseline;
+  };
+  auto ao = std::make_shared<AnalyzeOptions>();
+  CLI::App* ana = tma.add_subcommand("analyze", "Figures, tests and tables of a results tree");
+  ana->add_option("RESULTS", ao->results, "Results tree of `tma campaign launch`")->required();
+  ana->add_option("--out", ao->out, "Figures and tables folder (default RESULTS/analysis)");
+  ana->add_option("--baseline", ao->baseline,
+                  "Campaign compared against (default: the Random one)");
+  auto vo = std::make_shared<VideoOptions>();
+  CLI::App* vid = tma.add_subcommand("video", "Render a trained policy on one test task");
+  vid->add_option("--run", vo->run, "Run folder of `cradle tma run`")->required();
+  vid->add_option("--test-task", vo->test_task, "Row of the run's test_set.csv")->required();
+  vid->add_option("--out", vo->out, "Video file (.mp4 / .avi; default RUN/test_task_K.mp4)");
+  vid->add_option("--steps", vo->steps, "Episode step cap")->check(CLI::Range(1, 100000));
+  vid->add_option("--seed", vo->seed, "Seed of the episode");
+  vid->add_flag("--lidars", vo->lidars, "Draw the lidar rays");
+  vid->callback([vo] { video(*vo); });
+
+  ana->callback([ao] {
+    analyze(ao->results, ao->out.empty() ? (fs::path(ao->results) / "analysis").string() : ao->out,
+            ao->baseline);
+  });
+}
+
+}  // namespace cradle::apps
