@@ -547,6 +547,10 @@ def analyze(root, out=None, baseline=None, log=print):
             tag = f"{_safe(experiment)}_{ek}"
             tests = plot_curves(cell, baseline, f"{experiment}, {ek} EK", path(f"curves_{tag}.png"))
             welch_rows += [dict(t, experiment=experiment, ek=ek, embodiment="all") for t in tests]
+            # Mean test return: what moves before any task is mastered (short budgets).
+            plot_curves(cell, baseline, f"{experiment}, {ek} EK: mean test return",
+                        path(f"test_return_{tag}.png"), column="mean_test_return",
+                        ylabel="mean test return")
             plot_curves(cell, baseline, f"{experiment}, {ek} EK: training return",
                         path(f"train_return_{tag}.png"), column="mean_train_return",
                         ylabel="mean training return")

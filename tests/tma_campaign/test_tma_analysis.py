@@ -88,7 +88,8 @@ def test_every_figure_and_table_from_two_teachers_two_seeds(tmp_path):
     expected = {
         "curves_criterion_1_none.png", "curves_parkour_none.png",
         "curves_parkour_none_fish.png", "curves_parkour_none_old_classic_bipedal.png",
-        "train_return_parkour_none.png", "pairwise_parkour_none.png",
+        "train_return_parkour_none.png", "test_return_criterion_1_none.png",
+        "pairwise_parkour_none.png",
         "skill_radar.png", "skill_bars.png", "skill_ratios.csv",
         "curriculum_ALP-GMM_criterion_1_old_classic_bipedal.png",
         "curriculum_Random_parkour_fish.png",
