@@ -18,7 +18,7 @@ set(floor_sami core senses)
 set(floor_eval core model senses envs)
 set(floor_learn core envs)
 set(floor_teach core envs)
-set(floor_train core envs eval learn teach)
+set(floor_train core envs eval learn teach sami)
 # In learn/ and teach/, the only env headers.
 set(interface_only learn teach)
 set(interface_headers "envs/env.h" "envs/info.h" "envs/action_check.h")

@@ -16,6 +16,7 @@ packages=(
   libbox2d-dev libcairo2-dev libzip-dev libeigen3-dev
   python3-matplotlib python3-scipy python3-pandas
   slurm-wlm munge
+  python3-torch  # only for the side-by-side benchmark bench/sami_update_torch.py
 )
 
 missing=()

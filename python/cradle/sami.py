@@ -71,3 +71,68 @@ class SamiEnv(_EnvBase):
 def make(name, split="train", seed=0, **kwargs):
     """A SaMI env by name, e.g. make("CrippleHalfCheetah", split="moderate")."""
     return SamiEnv(name, split=split, seed=seed, **kwargs)
+
+
+METHODS = ("TESAC", "CCM", "SaTESAC", "SaCCM", "SaCCMAll")
+
+
+def train(env="PandaPush", method="SaCCM", seed=0, steps_per_env=0, hyperparameters=None,
+          out="", resume=False, checkpoint_every=100_000, progress_bar=False):
+    """`cradle sami train` from Python: trains a SaMI method on the env's training task sets.
+
+    steps_per_env=0 takes SaMI's budget (500k per env; PandaPush 1M). hyperparameters: a dict of
+    overrides ({"batch_size": 32}). Returns a dict: run, steps, updates, sps,
+    gradient_steps_per_s, last_return, checkpoint. Bad inputs raise ValueError (one line).
+    """
+    hp = {str(k): str(v).lower() if isinstance(v, bool) else
+          ",".join(str(x) for x in v) if isinstance(v, (list, tuple)) else str(v)
+          for k, v in (hyperparameters or {}).items()}
+    return _cradle.sami_train(str(env), str(method), int(seed), int(steps_per_env), hp, str(out),
+                              bool(resume), int(checkpoint_every), bool(progress_bar))
+
+
+def evaluate(run, split="train", episodes=10, video=False, seed=12345):
+    """`cradle sami evaluate` from Python: per task cell success rate, return and skill mix.
+
+    Writes eval_<split>.json / .csv and contexts_<split>.csv into the run folder and returns the
+    same numbers as a dict (cells: a list of dicts).
+    """
+    return _cradle.sami_evaluate(str(run), str(split), int(episodes), bool(video), int(seed))
+
+
+def table(runs, out=""):
+    """`cradle sami table`: the paper's Table 1/2 layout (markdown) over evaluated runs."""
+    return _cradle.sami_table([str(r) for r in runs], str(out))
+
+
+def plot_contexts(csv, png, title=None):
+    """Draws a contexts_<split>.csv (written by evaluate) as two scatter plots of its 2-D PCA:
+    coloured by task cell and by the step's skill label. Needs matplotlib."""
+    import csv as csv_module
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with open(csv, newline="") as f:
+        rows = list(csv_module.DictReader(f))
+    if not rows:
+        raise ValueError(f"{csv}: no contexts")
+    x = np.array([float(r["pc1"]) for r in rows])
+    y = np.array([float(r["pc2"]) for r in rows])
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, key, name in ((axes[0], "cell", "task"), (axes[1], "episode_skill", "skill")):
+        labels = sorted({r[key] for r in rows})
+        for i, label in enumerate(labels):
+            mask = np.array([r[key] == label for r in rows])
+            ax.scatter(x[mask], y[mask], s=4, alpha=0.6, label=label, color=plt.cm.tab10(i % 10))
+        ax.set_title(f"contexts by {name}")
+        ax.set_xlabel("PC 1")
+        ax.set_ylabel("PC 2")
+        ax.legend(fontsize=6, markerscale=3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png

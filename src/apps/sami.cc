@@ -1,8 +1,12 @@
-// `cradle sami random|bench|info`: the SaMI environment family (src/sami/). `random` runs random
-// episodes and prints each episode's return and hidden parameters (optionally an mp4 and a PNG of
-// the last frame); `bench` measures env steps/s against the bare mj_steps; `info` prints the
-// spaces and the task sets of every split.
+// `cradle sami random|bench|info|train|evaluate|table`: the SaMI environment family (src/sami/)
+// and its learners (src/learn/meta/, src/train/sami/). `random` runs random episodes and prints
+// each episode's return and hidden parameters (optionally an mp4 and a PNG of the last frame);
+// `bench` measures env steps/s against the bare mj_steps; `info` prints the spaces and the task
+// sets of every split; `train` / `evaluate` / `table` train a method, evaluate it on a split and
+// tabulate runs as the paper's Table 1/2.
 #include <cstdio>
+#include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +19,7 @@
 #include "sami/env.h"
 #include "sami/render.h"
 #include "sami/throughput.h"
+#include "train/sami/sami_train.h"
 
 namespace cradle::apps {
 namespace {
@@ -91,6 +96,87 @@ void random_episodes(const std::string& name, const std::string& split, int epis
   }
 }
 
+std::map<std::string, std::string> parse_hp(const std::vector<std::string>& pairs) {
+  std::map<std::string, std::string> out;
+  for (const std::string& kv : pairs) {
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw UserError("--hp '" + kv + "': expected name=value");
+    }
+    out[kv.substr(0, eq)] = kv.substr(eq + 1);
+  }
+  return out;
+}
+
+// train / evaluate / table.
+void register_learners(CLI::App& cmd) {
+  struct Options {
+    train::SamiTrainOptions train;
+    std::vector<std::string> hp;
+    std::string out;
+    train::SamiEvalOptions eval;
+    std::string run;
+    std::vector<std::string> runs;
+    std::string table_out;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* tr = cmd.add_subcommand("train",
+                                    "Train a SaMI method (TESAC, CCM, SaTESAC, SaCCM, "
+                                    "SaCCMAll) on an env's training task sets");
+  tr->add_option("--env", opts->train.env, "Env name (see `cradle sami info --env all`)");
+  tr->add_option("--method", opts->train.method, "TESAC, CCM, SaTESAC, SaCCM or SaCCMAll");
+  tr->add_option("--seed", opts->train.seed, "Seed");
+  tr->add_option("--steps-per-env", opts->train.steps_per_env,
+                 "Env steps per training env (default 500000; PandaPush 1000000)")
+      ->check(CLI::Range(1L, 10'000'000'000L));
+  tr->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
+  tr->add_option("--out", opts->out, "Run folder (default runs/sami/<env>_<method>_<seed>)");
+  tr->add_flag("--resume", opts->train.resume, "Continue the run in --out from its checkpoint");
+  tr->add_option("--checkpoint-every", opts->train.checkpoint_every,
+                 "Env steps per training env between checkpoints")
+      ->check(CLI::Range(1L, 10'000'000'000L));
+  tr->add_flag("!--no-progress", opts->train.progress_bar, "No progress bar");
+  tr->callback([opts] {
+    opts->train.hyperparameters = parse_hp(opts->hp);
+    opts->train.out = opts->out;
+    const train::SamiTrainResult r = train::sami_train(opts->train);
+    std::printf(
+        "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "
+        "last return %.3f\ncheckpoint: %s\n",
+        r.run.string().c_str(), r.steps, r.updates, r.sps, r.gradient_steps_per_s, r.last_return,
+        (r.run / "checkpoint.ckpt").string().c_str());
+  });
+
+  CLI::App* ev = cmd.add_subcommand("evaluate", "Evaluate a trained run on a split, per task cell");
+  ev->add_option("--run", opts->run, "Run folder of `cradle sami train`")->required();
+  ev->add_option("--split", opts->eval.split, "train, moderate or extreme");
+  ev->add_option("--episodes", opts->eval.episodes, "Episodes per task set (cell)")
+      ->check(CLI::Range(1, 100000));
+  ev->add_option("--seed", opts->eval.seed, "Seed of the evaluation envs");
+  ev->add_flag("--video", opts->eval.video, "Write eval_<split>.mp4 (first episode per cell)");
+  ev->callback([opts] {
+    opts->eval.run = opts->run;
+    const train::SamiEvalResult r = train::sami_evaluate(opts->eval);
+    std::printf("%-44s %8s %8s %12s %6s %6s %6s\n", "cell", "episodes", "success", "return", "push",
+                "roll", "pick");
+    for (const train::SamiCell& c : r.cells) {
+      std::printf("%-44s %8d %8.2f %12.2f %6.2f %6.2f %6.2f\n", c.name.c_str(), c.episodes,
+                  c.success_rate, c.mean_return, c.push, c.roll, c.pick_and_place);
+    }
+    std::printf("%s: success %.3f, mean return %.2f\nwritten: %s, %s, %s\n", r.split.c_str(),
+                r.success_rate, r.mean_return, r.json.string().c_str(), r.csv.string().c_str(),
+                r.contexts.string().c_str());
+  });
+
+  CLI::App* tb = cmd.add_subcommand("table", "The paper's Table 1/2 over evaluated runs");
+  tb->add_option("runs", opts->runs, "Run folders (evaluated)")->required();
+  tb->add_option("--out", opts->table_out, "Also write the table to this file");
+  tb->callback([opts] {
+    std::vector<std::filesystem::path> runs(opts->runs.begin(), opts->runs.end());
+    std::printf("%s", train::sami_table(runs, opts->table_out).c_str());
+  });
+}
+
 std::vector<sami::EnvId> envs_named(const std::string& name) {
   if (name == "all") {
     const auto all = sami::all_envs();
@@ -145,6 +231,8 @@ void register_sami(CLI::App& app) {
                   t.env_steps_per_s, t.bare_steps_per_s, t.ratio);
     }
   });
+
+  register_learners(*cmd);
 
   CLI::App* info = cmd->add_subcommand("info", "Spaces and task sets of an env");
   info->add_option("--env", opts->env, "Env name or all");

@@ -43,6 +43,44 @@ namespace {
 constexpr double kLogStdMin = -20.0;
 constexpr double kLogStdMax = 2.0;
 
+}  // namespace
+
+std::pair<torch::Tensor, torch::Tensor> squashed_gaussian_sample(const torch::Tensor& mean,
+                                                                 const torch::Tensor& log_std_raw,
+                                                                 at::Generator& generator) {
+  const torch::Tensor log_std = torch::clamp(log_std_raw, kLogStdMin, kLogStdMax);
+  const torch::Tensor eps = torch::randn(mean.sizes(), generator, torch::kFloat32);
+  const torch::Tensor u = mean + torch::exp(log_std) * eps;
+  const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
+  const torch::Tensor log_gaussian = -0.5 * eps.square() - log_std - half_log_2pi;
+  const torch::Tensor log_jacobian =
+      2.0 * (std::numbers::ln2 - u - torch::nn::functional::softplus(-2.0 * u));
+  return {torch::tanh(u), (log_gaussian - log_jacobian).sum(1)};
+}
+
+torch::Tensor sac_alpha_loss(const torch::Tensor& log_alpha, const torch::Tensor& log_pi,
+                             double target_entropy) {
+  return -(log_alpha * (log_pi.detach() + target_entropy)).mean();
+}
+
+torch::Tensor sac_soft_target(const torch::Tensor& rewards, const torch::Tensor& terminated,
+                              const torch::Tensor& next_q, const torch::Tensor& next_log_pi,
+                              const torch::Tensor& alpha, double gamma) {
+  const torch::Tensor soft_q = std::get<0>(next_q.min(0)) - alpha * next_log_pi;
+  return rewards + gamma * (1.0 - terminated) * soft_q;
+}
+
+torch::Tensor sac_critic_losses(const torch::Tensor& q, const torch::Tensor& target) {
+  return (q - target.unsqueeze(0)).square().mean(1);
+}
+
+torch::Tensor sac_actor_loss(const torch::Tensor& alpha, const torch::Tensor& log_pi,
+                             const torch::Tensor& q_pi) {
+  return (alpha * log_pi - std::get<0>(q_pi.min(0))).mean();
+}
+
+namespace {
+
 // Reads a number; UserError naming the hyperparameter otherwise.
 double parse_double(const std::string& name, std::string_view text) {
   double value = 0;
@@ -79,15 +117,7 @@ class SquashedGaussianActorImpl : public torch::nn::Module {
   std::pair<torch::Tensor, torch::Tensor> sample(const ObsBatch& observation,
                                                  at::Generator& generator) {
     const torch::Tensor h = latent_->forward(encoder_->forward(observation));
-    const torch::Tensor mean = mean_(h);
-    const torch::Tensor log_std = torch::clamp(log_std_(h), kLogStdMin, kLogStdMax);
-    const torch::Tensor eps = torch::randn(mean.sizes(), generator, torch::kFloat32);
-    const torch::Tensor u = mean + torch::exp(log_std) * eps;
-    const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
-    const torch::Tensor log_gaussian = -0.5 * eps.square() - log_std - half_log_2pi;
-    const torch::Tensor log_jacobian =
-        2.0 * (std::numbers::ln2 - u - torch::nn::functional::softplus(-2.0 * u));
-    return {torch::tanh(u), (log_gaussian - log_jacobian).sum(1)};
+    return squashed_gaussian_sample(mean_(h), log_std_(h), generator);
   }
 
  private:
@@ -172,7 +202,7 @@ class Sac final : public OffPolicyLearner {
     auto [pi_actions, log_pi] = actor_->sample(batch.observations, generator());
     const torch::Tensor alpha = log_alpha_.detach().exp();
     if (learn_alpha_) {
-      const torch::Tensor alpha_loss = -(log_alpha_ * (log_pi.detach() + target_entropy_)).mean();
+      const torch::Tensor alpha_loss = sac_alpha_loss(log_alpha_, log_pi, target_entropy_);
       alpha_optimizer_.zero_grad();
       alpha_loss.backward();
       alpha_optimizer_.step();
@@ -184,15 +214,14 @@ class Sac final : public OffPolicyLearner {
     {
       torch::NoGradGuard no_grad;
       auto [next_actions, next_log_pi] = actor_->sample(batch.next_observations, generator());
-      const torch::Tensor next_q =
-          std::get<0>(critic_target_->forward(batch.next_observations, next_actions).min(0)) -
-          alpha * next_log_pi;
-      target = batch.rewards + loop_.gamma * (1.0 - batch.terminated) * next_q;
+      target = sac_soft_target(batch.rewards, batch.terminated,
+                               critic_target_->forward(batch.next_observations, next_actions),
+                               next_log_pi, alpha, loop_.gamma);
     }
 
     // Critics: regress every Q on the target.
     const torch::Tensor q = critic_->forward(batch.observations, batch.actions);
-    const torch::Tensor q_losses = (q - target.unsqueeze(0)).square().mean(1);
+    const torch::Tensor q_losses = sac_critic_losses(q, target);
     const torch::Tensor qf_loss = 0.5 * q_losses.sum();
     critic_parameters_.zero_grad();
     qf_loss.backward();
@@ -202,9 +231,7 @@ class Sac final : public OffPolicyLearner {
     torch::Tensor actor_loss;
     {
       const FrozenParameters frozen(*critic_);
-      const torch::Tensor q_pi =
-          std::get<0>(critic_->forward(batch.observations, pi_actions).min(0));
-      actor_loss = (alpha * log_pi - q_pi).mean();
+      actor_loss = sac_actor_loss(alpha, log_pi, critic_->forward(batch.observations, pi_actions));
       actor_parameters_.zero_grad();
       actor_loss.backward();
     }

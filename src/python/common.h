@@ -52,5 +52,6 @@ void bind_learn(py::module_& m);
 void bind_tma(py::module_& m);
 void bind_sami(py::module_& m);
 void bind_teach(py::module_& m);
+void bind_sami_learn(py::module_& m);  // sami_learn.cc, called by bind_sami
 
 }  // namespace cradle::python

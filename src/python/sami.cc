@@ -59,6 +59,7 @@ py::dict info(const sami::SamiEnv& env) {
 }  // namespace
 
 void bind_sami(py::module_& m) {
+  bind_sami_learn(m);
   m.def("sami_env_names", [] {
     py::list names;
     for (sami::EnvId id : sami::all_envs()) names.append(std::string(sami::env_name(id)));

@@ -1,0 +1,82 @@
+// SaMI training, evaluation and tables (tma_sami.md §6-§8): `cradle sami train / evaluate / table`
+// and cradle.sami.train / evaluate in Python.
+//
+// A run folder holds run.json (env, method, seed, budget, hyperparameters), progress.csv,
+// checkpoint.ckpt (sealed, written every checkpoint_every env steps per env and at the end) and,
+// after evaluation, eval_<split>.json / .csv and contexts_<split>.csv.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sami/task.h"
+
+namespace cradle::train {
+
+// The training task sets, one sub-env each (SaMI's DummyVecEnv). A split with a single set that
+// varies its crippling (or else its mass) is split into one set per choice, so that the methods
+// that contrast envs have more than one.
+std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id);
+
+struct SamiTrainOptions {
+  std::string env = "PandaPush";
+  std::string method = "SaCCM";
+  std::uint64_t seed = 0;
+  long steps_per_env = 0;  // 0: SaMI's budget (500,000; PandaPush 1,000,000)
+  std::map<std::string, std::string> hyperparameters;
+  std::filesystem::path out;        // run folder; empty: runs/sami/<env>_<method>_<seed>
+  bool resume = false;              // continue the run in `out` from its checkpoint
+  long checkpoint_every = 100'000;  // env steps per training env between checkpoints
+  long report_every = 0;            // vector steps between progress rows (0: one episode length)
+  bool progress_bar = true;
+};
+
+struct SamiTrainResult {
+  std::filesystem::path run;
+  long steps = 0;                   // env steps (all sub-envs)
+  long updates = 0;                 // gradient steps
+  double sps = 0;                   // env steps per second, whole run of this call
+  double gradient_steps_per_s = 0;  // gradient steps per second of update time
+  double last_return = 0;           // mean return of the episodes of the last report
+};
+SamiTrainResult sami_train(const SamiTrainOptions& options);
+
+struct SamiEvalOptions {
+  std::filesystem::path run;
+  std::string split = "train";
+  int episodes = 10;   // per task set (cell)
+  bool video = false;  // eval_<split>.mp4: the first episode of each cell
+  std::uint64_t seed = 12345;
+};
+
+struct SamiCell {
+  std::string name;  // "friction 0.1, mass 1" or the set's values
+  int episodes = 0;
+  double success_rate = 0, mean_return = 0, std_return = 0;
+  double push = 0, roll = 0, pick_and_place = 0;  // Panda: the episodes' skill mix
+};
+struct SamiEvalResult {
+  std::string split;
+  std::vector<SamiCell> cells;
+  double success_rate = 0, mean_return = 0;  // over all episodes
+  std::filesystem::path json, csv, contexts;
+};
+SamiEvalResult sami_evaluate(const SamiEvalOptions& options);
+
+// Welch's unequal-variance t-test: t = (mean a - mean b) / sqrt(va/na + vb/nb) and the two-sided
+// p from Student's t with the Welch-Satterthwaite degrees of freedom.
+struct Welch {
+  double t = 0, p = 1, dof = 0;
+};
+Welch welch_test(const std::vector<double>& a, const std::vector<double>& b);
+
+// The paper's Table 1/2 layout over evaluated runs: per env, method and split, mean +- std over
+// seeds of the runs' split scores (Panda: success rate, else mean return), then Welch's t and p of
+// SaCCM vs CCM and SaTESAC vs TESAC. Returns the text (markdown); writes it to `out` if given.
+std::string sami_table(const std::vector<std::filesystem::path>& runs,
+                       const std::filesystem::path& out = {});
+
+}  // namespace cradle::train

@@ -1,0 +1,144 @@
+// The SaMI train / evaluate / table loop: a few-hundred-step run of every method on Panda push
+// and on a crippled locomotion env, resume, evaluation files and the table.
+#include "train/sami/sami_train.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "core/error.h"
+#include "learn/meta/samplers.h"
+
+namespace cradle::train {
+namespace {
+
+// Small networks and batches so that a run takes a fraction of a second.
+std::map<std::string, std::string> tiny_hp() {
+  return {{"net_arch", "32,32"},        {"lstm_hidden", "16"},     {"batch_size", "4"},
+          {"contrast_batch_size", "4"}, {"buffer_size", "8"},      {"train_freq", "10"},
+          {"gradient_steps", "2"},      {"learning_starts", "60"}, {"adversarial_loss_coef", "1"}};
+}
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cradle_sami_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+int lines(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+TEST(SamiTrain, EveryMethodRunsOnPandaAndACrippledEnv) {
+  for (const std::string env : {"PandaPush", "CrippleHalfCheetah"}) {
+    for (const std::string_view method : learn::meta::method_names()) {
+      const auto dir = scratch(env + std::string(method));
+      auto hp = tiny_hp();
+      if (env != "PandaPush") {  // train after the first 1000-step episodes, 3 updates
+        hp["learning_starts"] = "1000";
+        hp["train_freq"] = "20";
+        hp["gradient_steps"] = "1";
+      }
+      const SamiTrainResult r = sami_train({.env = env,
+                                            .method = std::string(method),
+                                            .seed = 1,
+                                            .steps_per_env = env == "PandaPush" ? 200 : 1040,
+                                            .hyperparameters = hp,
+                                            .out = dir,
+                                            .progress_bar = false});
+      const int envs = env == "PandaPush" ? 6 : 3;  // CrippleHalfCheetah: one set per joint
+      EXPECT_EQ(r.steps, (env == "PandaPush" ? 200 : 1040) * envs) << env << method;
+      EXPECT_GT(r.updates, 0) << env << method;
+      EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.ckpt"));
+      EXPECT_GE(lines(dir / "progress.csv"), 2);
+      std::filesystem::remove_all(dir);
+    }
+  }
+}
+
+TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
+  const auto dir = scratch("resume");
+  SamiTrainOptions o{.env = "PandaPush",
+                     .method = "SaCCM",
+                     .seed = 2,
+                     .steps_per_env = 100,
+                     .hyperparameters = tiny_hp(),
+                     .out = dir,
+                     .report_every = 25,
+                     .progress_bar = false};
+  sami_train(o);
+  EXPECT_THROW(sami_train(o), UserError);  // the folder holds a run: --resume or another --out
+  o.resume = true;
+  o.steps_per_env = 200;
+  const SamiTrainResult r = sami_train(o);
+  EXPECT_EQ(r.steps, 1200);
+  EXPECT_EQ(lines(dir / "progress.csv"), 1 + 200 / 25);  // header + one row per 25 vector steps
+
+  const SamiEvalResult e = sami_evaluate({.run = dir, .split = "extreme", .episodes = 1});
+  ASSERT_EQ(e.cells.size(), 8u);  // Panda's 8 extreme cells
+  for (const SamiCell& c : e.cells) {
+    EXPECT_NEAR(c.push + c.roll + c.pick_and_place, 1.0, 1e-9) << c.name;  // one label each
+  }
+  // A row per step: 50 per episode unless it succeeded earlier.
+  EXPECT_GT(lines(e.contexts), 1 + 8);
+  EXPECT_LE(lines(e.contexts), 1 + 8 * 50);
+  std::ifstream json(e.json);
+  const auto j = nlohmann::json::parse(json);
+  EXPECT_EQ(j.at("method"), "SaCCM");
+  EXPECT_EQ(j.at("cells").size(), 8u);
+  EXPECT_THROW(sami_evaluate({.run = dir, .split = "hard"}), UserError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SamiTable, MeansStdsAndWelchPerSplit) {
+  const auto root = scratch("table");
+  const double train_scores[2][3] = {{0.9, 0.95, 0.92}, {0.5, 0.6, 0.55}};
+  std::vector<std::filesystem::path> runs;
+  for (int m = 0; m < 2; ++m) {
+    for (int s = 0; s < 3; ++s) {
+      const auto run = root / (std::to_string(m) + "_" + std::to_string(s));
+      std::filesystem::create_directories(run);
+      std::ofstream(run / "eval_train.json") << nlohmann::json{
+          {"env", "PandaPush"},
+          {"method", m ? "CCM" : "SaCCM"},
+          {"success_rate", train_scores[m][s]},
+          {"mean_return", -10}}.dump();
+      runs.push_back(run);
+    }
+  }
+  const std::string table = sami_table(runs);
+  EXPECT_NE(table.find("| SaCCM | 3 | 0.92 ± 0.03 | – | – |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| CCM | 3 | 0.55 ± 0.05 | – | – |"), std::string::npos) << table;
+  const Welch w = welch_test({0.9, 0.95, 0.92}, {0.5, 0.6, 0.55});
+  char expected[64];
+  std::snprintf(expected, sizeof(expected), "t = %.2f, p = %.4f", w.t, w.p);
+  EXPECT_NE(table.find(std::string("| SaCCM vs CCM | ") + expected), std::string::npos) << table;
+  EXPECT_THROW(sami_table({root / "missing"}), UserError);
+  std::filesystem::remove_all(root);
+}
+
+TEST(SamiTrain, BadInputsAreOneLineErrors) {
+  EXPECT_THROW(sami_train({.env = "Nope", .out = scratch("bad")}), UserError);
+  EXPECT_THROW(sami_train({.env = "PandaPush", .method = "SaCCM2", .out = scratch("bad")}),
+               UserError);
+  EXPECT_THROW(
+      sami_train(
+          {.env = "PandaPush", .hyperparameters = {{"neg_ratio", "2"}}, .out = scratch("bad")}),
+      UserError);
+  // CCM contrasts envs: CrippleHopper's single training set splits into one env per mass value.
+  EXPECT_EQ(sami_training_sets(sami::EnvId::kCrippleHopper).size(), 5u);
+  EXPECT_EQ(sami_training_sets(sami::EnvId::kCrippleHalfCheetah).size(), 3u);
+  EXPECT_EQ(sami_training_sets(sami::EnvId::kPandaPush).size(), 6u);
+  std::filesystem::remove_all(scratch("bad"));
+}
+
+}  // namespace
+}  // namespace cradle::train
