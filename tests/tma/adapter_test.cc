@@ -1,8 +1,12 @@
 // The cradle::envs::Env adapter: spaces, observation copy and the success / failure flags.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "envs/tma/tma_env.h"
 
 namespace cradle::envs {
@@ -27,6 +31,29 @@ TEST(TmaAdapter, SpacesObservationAndFailure) {
   EXPECT_TRUE(env.info().flag(env.info().find("is_failure")));
   EXPECT_FALSE(env.info().flag(env.info().find("is_success")));
   EXPECT_EQ(env.observation().f64(0)[1], env.env().observation()[1]);
+}
+
+// NaN and infinite actions are refused with the shared one-line error, before any physics.
+TEST(TmaAdapter, NonFiniteActionsAreRefused) {
+  TmaEnvAdapter env(tma::TmaOptions{.env = tma::EnvId::kStumpTracks, .body = "spider"});
+  env.reset(2);
+  const std::vector<double> before(env.observation().f64(0).begin(),
+                                   env.observation().f64(0).end());
+  for (double bad : {std::nan(""), double{INFINITY}, -double{INFINITY}}) {
+    std::vector<double> action(12, 0.0);
+    action[5] = bad;
+    try {
+      env.step(action);
+      FAIL() << "no error for " << bad;
+    } catch (const UserError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("action 5"), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+  EXPECT_EQ(env.env().episode_steps(), 0);
+  const auto after = env.observation().f64(0);
+  EXPECT_TRUE(std::equal(before.begin(), before.end(), after.begin()));
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "envs/action_check.h"
+
 namespace cradle::envs {
 namespace {
 
@@ -28,6 +30,7 @@ void TmaEnvAdapter::reset(std::optional<std::uint64_t> seed) {
 }
 
 StepResult TmaEnvAdapter::step(std::span<const double> action) {
+  check_finite_actions(action);
   const tma::TmaStep r = env_.step(action);
   info_.steps = env_.episode_steps() - 1;
   info_.set(success_slot_, r.success);
