@@ -1,10 +1,12 @@
-// `cradle illustrate --env reach|standup|selfbody|catch --train_for N --test_for M --algorithm
-// PPO|SAC|TD3|DDPG|A2C [--save_every K] [--save_model NAME] [--load_model PATH] [--use_muscles]
-// [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]`: the reference's
-// illustrations.py. Trains a policy on a MIMo sample env (checkpoints
+// `cradle illustrate --env reach|standup|selfbody|catch [--train_for N] [--test_for M]
+// [--algorithm PPO|SAC|TD3|DDPG|A2C] [--save_every K] [--save_model NAME] [--load_model PATH]
+// [--use_muscles] [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]`: the
+// reference's illustrations.py. Trains a policy on a MIMo sample env (checkpoints
 // models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv, learning-curve PNGs),
 // then runs test_for steps with it (or with random actions when there is no model), optionally
-// filming each episode, and prints the success rate and the mean return per episode.
+// filming each episode, and prints the success rate and the mean return per episode. Without
+// --algorithm the algorithm is the --load_model checkpoint's; without either, testing takes
+// random actions (training then needs --algorithm).
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -105,7 +107,11 @@ bool plot_curves(const Curves& c, const std::string& title, const fs::path& dir)
 void run(const IllustrateOptions& o) {
   // Flags first, before anything is built.
   const std::string id = envs::sample_env_id(o.env);
-  const std::string algorithm = learner_name(o.algorithm);
+  // No --algorithm: the checkpoint's (--load_model), else none (testing with random actions).
+  std::string algorithm = o.algorithm.empty() ? "" : learner_name(o.algorithm);
+  if (algorithm.empty() && o.load_model.empty() && o.train_for > 0) {
+    throw UserError("--train_for needs --algorithm (PPO, SAC, TD3, DDPG or A2C) or --load_model");
+  }
   if (o.train_for < 0 || o.test_for < 0) throw UserError("--train_for and --test_for must be >= 0");
   if (o.save_every < 1) throw UserError("--save_every must be at least 1");
   if (o.envs < 1) throw UserError("--envs must be at least 1");
@@ -124,6 +130,7 @@ void run(const IllustrateOptions& o) {
   }
   if (!o.load_model.empty()) {
     const learn::CheckpointInfo info = learn::read_checkpoint_info(o.load_model);
+    if (algorithm.empty()) algorithm = info.algorithm;
     if (info.algorithm != algorithm) {
       throw UserError("--load_model '" + o.load_model + "' holds a " + info.algorithm +
                       " model, not " + algorithm);
@@ -222,7 +229,7 @@ void run(const IllustrateOptions& o) {
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
-    if (!curves.steps.empty() && plot_curves(curves, id + " " + o.algorithm, dir)) {
+    if (!curves.steps.empty() && plot_curves(curves, id + " " + (o.algorithm.empty() ? algorithm : o.algorithm), dir)) {
       std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
     }
   }
@@ -311,7 +318,9 @@ void register_illustrate(CLI::App& app) {
   cmd->add_option("--train_for", o->train_for, "Env steps of training (0: none)");
   cmd->add_option("--test_for", o->test_for, "Env steps of testing");
   cmd->add_option("--save_every", o->save_every, "Env steps between saved models");
-  cmd->add_option("--algorithm", o->algorithm, "PPO, SAC, TD3, DDPG or A2C")->required();
+  cmd->add_option("--algorithm", o->algorithm,
+                  "PPO, SAC, TD3, DDPG or A2C (default: the --load_model checkpoint's; without "
+                  "either, testing takes random actions)");
   cmd->add_option("--load_model", o->load_model, "Model checkpoint to start from");
   cmd->add_option("--save_model", o->save_model, "Name: models are saved in models/<env>/<name>");
   cmd->add_flag("--render_video", o->render_video, "Film every test episode (episode_<i>.mp4)");

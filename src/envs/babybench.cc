@@ -1,6 +1,7 @@
 #include "envs/babybench.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <string_view>
 
@@ -10,45 +11,26 @@
 namespace cradle::envs {
 namespace {
 
-senses::ProprioOptions proprio_options(const Config& c) {
-  return {.velocity = c.proprio_velocity,
-          .torque = c.proprio_torque,
-          .limits = c.proprio_limits,
-          .actuation = c.proprio_actuation};
-}
+using Clock = std::chrono::steady_clock;
 
-double seconds(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration<double>(d).count();
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// The senses a config turns on.
+MimoSenses config_senses(const BabyBenchAssets& assets) {
+  const Config& c = assets.config;
+  return {.proprio = {.velocity = c.proprio_velocity,
+                      .torque = c.proprio_torque,
+                      .limits = c.proprio_limits,
+                      .actuation = c.proprio_actuation},
+          .touch = assets.touch.get(),
+          .vision_resolution = c.vision_active ? c.vision_resolution : 0,
+          .vestibular = c.vestibular_active};
 }
 
 }  // namespace
 
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size) {
-  const Config& c = assets.config;
-  const mjModel* m = assets.model.get();
-  // Keys in the reference's order: proprioception, touch, eyes, vestibular.
-  DictSpace space;
-  space.entries.emplace_back(
-      BabyBenchEnv::kProprioKey,
-      senses::Proprioception(m, proprio_options(c), actuation_obs_size).space());
-  if (assets.touch) space.entries.emplace_back(BabyBenchEnv::kTouchKey, assets.touch->space());
-  if (c.vision_active) {
-    const Box eye = senses::Eyes::space_for(c.vision_resolution);
-    space.entries.emplace_back(BabyBenchEnv::kEyeLeftKey, eye);
-    space.entries.emplace_back(BabyBenchEnv::kEyeRightKey, eye);
-  }
-  if (c.vestibular_active) {
-    space.entries.emplace_back(BabyBenchEnv::kVestibularKey, senses::Vestibular(m).space());
-  }
-  return space;
-}
-
-ObservationLayout skin_layout(const senses::Touch& touch) {
-  ObservationLayout layout{.values_per_item = touch.values_per_sensor()};
-  const std::span<const int> geoms = touch.sensor_geoms(), bodies = touch.sensor_bodies();
-  layout.groups["geom"].assign(geoms.begin(), geoms.end());
-  layout.groups["body"].assign(bodies.begin(), bodies.end());
-  return layout;
+  return mimo_observation_space(assets.model.get(), config_senses(assets), actuation_obs_size);
 }
 
 namespace {
@@ -97,24 +79,12 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
 
 BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::uint64_t seed)
     : assets_(std::move(assets)),
-      sim_(assets_->model.get(), assets_->config.actuation_model, assets_->config.frame_skip),
-      proprio_(assets_->model.get(), proprio_options(assets_->config),
-               sim_.actuation().observation_size()),
+      core_(assets_->model.get(), assets_->config.actuation_model, assets_->config.frame_skip,
+            config_senses(*assets_)),
       task_(make_behaviour(assets_->config, assets_->model.get())),
       contacts_(assets_->model.get()),
-      observation_space_(
-          babybench_observation_space(*assets_, sim_.actuation().observation_size())),
-      obs_(observation_space_),
-      proprio_index_(key_index(kProprioKey)),
-      touch_index_(key_index(kTouchKey)),
-      eye_left_index_(key_index(kEyeLeftKey)),
-      eye_right_index_(key_index(kEyeRightKey)),
-      vestibular_index_(key_index(kVestibularKey)),
       rng_(seed) {
-  const Config& c = assets_->config;
   const mjModel* m = assets_->model.get();
-  if (c.vestibular_active) vestibular_.emplace(m);
-  if (c.vision_active) eyes_ = std::make_unique<senses::Eyes>(m, c.vision_resolution);
   random_action_.resize(action_space().size());
   for (int j = 0; j < m->njnt; ++j) {
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
@@ -128,8 +98,8 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
 
   task_->declare(info_);
   contacts_.declare(info_);
-  sim_.restore(assets_->settled);
-  observe();
+  core_.sim().restore(assets_->settled);
+  core_.observe();
 }
 
 BabyBenchEnv::~BabyBenchEnv() {
@@ -196,22 +166,16 @@ std::unique_ptr<BabyBenchEnv> make_env(const Config& config, bool training, std:
   return env;
 }
 
-int BabyBenchEnv::key_index(std::string_view key) const {
-  for (int i = 0; i < static_cast<int>(observation_space_.entries.size()); ++i) {
-    if (observation_space_.entries[i].first == key) return i;
-  }
-  return -1;
-}
-
 void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
   if (log_ && !skip_record_) log_->record(info_, steps_, score(), log_slot_);
   skip_record_ = false;
   if (seed) rng_.seed_with(*seed);
-  sim_.reset();
-  sim_.restore(assets_->settled);
+  sim::Sim& sim = core_.sim();
+  sim.reset();
+  sim.restore(assets_->settled);
   if (randomize_start_ || start_posture_range_ > 0) {
     const mjModel* m = model();
-    mjData* d = sim_.data();
+    mjData* d = sim.data();
     const double r = randomize_start_ ? 1.0 : start_posture_range_;
     for (int j : free_joints_) {
       double& q = d->qpos[m->jnt_qposadr[j]];
@@ -227,57 +191,31 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
     for (size_t k = 0; k < random_action_.size(); ++k) {
       random_action_[k] = rng_.uniform(space.low[k], space.high[k]);
     }
-    sim_.step(random_action_);
+    sim.step(random_action_);
   }
   steps_ = 0;
   info_.clear();
-  task_->reset(model(), sim_.data(), info_);
-  contacts_.update(sim_.data(), info_);
-  observe();
+  task_->reset(core_, info_);
+  contacts_.update(sim.data(), info_);
+  core_.observe();
 }
 
 StepResult BabyBenchEnv::step(std::span<const double> action) {
   check_finite_actions(action);
-  const Clock::time_point start = Clock::now();
-  sim_.step(action);
-  profile_.physics += seconds(Clock::now() - start);
-  observe();
+  core_.step(action, /*contact_forces=*/false);
+  core_.observe();
 
   const Clock::time_point task_start = Clock::now();
   info_.steps = steps_;
   StepResult result;
-  result.reward = task_->after_step(model(), sim_.data(), info_);
-  contacts_.update(sim_.data(), info_);
+  result.reward = task_->after_step(core_, info_);
+  contacts_.update(core_.data(), info_);
   ++steps_;
   result.truncated = steps_ >= assets_->config.max_episode_steps;
-  profile_.other += seconds(Clock::now() - task_start);
-  ++profile_.steps;
+  Profile& profile = core_.profile();
+  profile.other += seconds(Clock::now() - task_start);
+  ++profile.steps;
   return result;
-}
-
-void BabyBenchEnv::observe() {
-  const mjModel* m = model();
-  mjData* d = sim_.data();
-  Clock::time_point t = Clock::now();
-  auto lap = [&](double& bucket) {
-    const Clock::time_point now = Clock::now();
-    bucket += seconds(now - t);
-    t = now;
-  };
-  proprio_.read(m, d, sim_.actuation(), obs_.f64(proprio_index_));
-  lap(profile_.proprio);
-  if (touch_index_ >= 0) {
-    touch()->read(m, d, obs_.f32(touch_index_));
-    lap(profile_.touch);
-  }
-  if (eyes_) {
-    eyes_->render(m, d, obs_.u8(eye_left_index_), obs_.u8(eye_right_index_));
-    lap(profile_.vision);
-  }
-  if (vestibular_) {
-    vestibular_->read(d, obs_.f64(vestibular_index_));
-    lap(profile_.vestibular);
-  }
 }
 
 }  // namespace cradle::envs

@@ -1,9 +1,9 @@
-// The BabyBench env: MIMo's simulation, his senses and a behaviour, configured by a BabyBench
-// YAML config. Everything a config compiles to once (model, touch sensor layout, settled start
-// state) lives in BabyBenchAssets and is shared read-only by every env built from it.
+// The BabyBench env: the MIMo env core (simulation and senses) and a behaviour (a Task),
+// configured by a BabyBench YAML config. Everything a config compiles to once (model, touch sensor
+// layout, settled start state) lives in BabyBenchAssets and is shared read-only by every env built
+// from it.
 #pragma once
 
-#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,14 +13,12 @@
 #include "core/config.h"
 #include "core/rng.h"
 #include "envs/env.h"
+#include "envs/mimo_core.h"
 #include "envs/self_touch.h"
 #include "envs/task.h"
 #include "envs/training_log.h"
 #include "scene/compose.h"
-#include "senses/proprioception.h"
 #include "senses/touch.h"
-#include "senses/vestibular.h"
-#include "senses/vision.h"
 #include "sim/sim.h"
 
 namespace cradle::envs {
@@ -51,27 +49,17 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
 // holds that many entries (a resumed run).
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log = -1);
 
-// The skin's layout: 1 or 3 values per sensor; groupings "geom" and "body" (the geom and body
-// each sensor sits on; a body's sensors are contiguous).
-ObservationLayout skin_layout(const senses::Touch& touch);
-
 // The observation space a config produces, without building an env (no GL context needed).
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size);
-
-// Wall time per env step spent in each module (for `cradle bench`).
-struct Profile {
-  double physics = 0, touch = 0, vision = 0, proprio = 0, vestibular = 0, other = 0;  // seconds
-  long steps = 0;
-};
 
 class BabyBenchEnv final : public Env {
  public:
   // Observation keys, in the reference's order.
-  static constexpr const char* kProprioKey = "observation";
-  static constexpr const char* kTouchKey = "touch";
-  static constexpr const char* kEyeLeftKey = "eye_left";
-  static constexpr const char* kEyeRightKey = "eye_right";
-  static constexpr const char* kVestibularKey = "vestibular";
+  static constexpr const char* kProprioKey = MimoCore::kProprioKey;
+  static constexpr const char* kTouchKey = MimoCore::kTouchKey;
+  static constexpr const char* kEyeLeftKey = senses::Eyes::kLeftKey;
+  static constexpr const char* kEyeRightKey = senses::Eyes::kRightKey;
+  static constexpr const char* kVestibularKey = MimoCore::kVestibularKey;
 
   static constexpr int kSettleSteps = 100;      // zero-action physics steps at construction
   static constexpr int kRandomResetSteps = 10;  // random actions applied at every reset
@@ -101,45 +89,36 @@ class BabyBenchEnv final : public Env {
   double score() const override { return task_->score(info_, steps_); }
   const ObservationLayout* layout(std::string_view key) const override;
 
-  const DictSpace& observation_space() const override { return observation_space_; }
-  const Box& action_space() const override { return sim_.actuation().action_space(); }
+  const DictSpace& observation_space() const override { return core_.observation_space(); }
+  const Box& action_space() const override { return core_.action_space(); }
   void reset(std::optional<std::uint64_t> seed = std::nullopt) override;
   StepResult step(std::span<const double> action) override;
-  const ObservationBuffers& observation() const override { return obs_; }
+  const ObservationBuffers& observation() const override { return core_.observation(); }
   const Info& info() const override { return info_; }
 
   const Config& config() const { return assets_->config; }
   const mjModel* model() const { return assets_->model.get(); }
-  const mjData* data() const { return sim_.data(); }
+  const mjData* data() const { return core_.data(); }
   // For renderers only: MuJoCo's scene update takes a non-const mjData but does not change the
   // simulation state.
-  mjData* render_data() const { return const_cast<mjData*>(sim_.data()); }
+  mjData* render_data() const { return const_cast<mjData*>(core_.data()); }
   const Task& task() const { return *task_; }
   const senses::Touch* touch() const { return assets_->touch.get(); }
-  const senses::Proprioception& proprioception() const { return proprio_; }
+  const senses::Proprioception& proprioception() const { return core_.proprioception(); }
   int episode_steps() const { return steps_; }
-  const Profile& profile() const { return profile_; }
-  void clear_profile() { profile_ = {}; }
+  const Profile& profile() const { return core_.profile(); }
+  void clear_profile() { core_.profile() = {}; }
   // Index of an observation key in observation_space() (-1 if absent).
-  int key_index(std::string_view key) const;
+  int key_index(std::string_view key) const { return core_.key_index(key); }
 
  private:
-  using Clock = std::chrono::steady_clock;
-  void observe();
-
   std::shared_ptr<const BabyBenchAssets> assets_;
-  sim::Sim sim_;
-  senses::Proprioception proprio_;
-  std::optional<senses::Vestibular> vestibular_;
-  std::unique_ptr<senses::Eyes> eyes_;
+  MimoCore core_;
   std::unique_ptr<Task> task_;
   HandContacts contacts_;
   std::shared_ptr<TrainingLog> log_;
   int log_slot_ = -1;
   bool skip_record_ = false;  // the current episode is already recorded (or not this env's)
-  DictSpace observation_space_;
-  ObservationBuffers obs_;
-  const int proprio_index_, touch_index_, eye_left_index_, eye_right_index_, vestibular_index_;
   Info info_;
   Rng rng_;
   std::vector<double> random_action_;
@@ -147,7 +126,6 @@ class BabyBenchEnv final : public Env {
   double start_posture_range_ = 0;  // [0, 1]: share of each joint's range drawn around the start
   std::vector<int> free_joints_;    // robot:* joints no active joint equality holds
   int steps_ = 0;
-  Profile profile_;
 };
 
 }  // namespace cradle::envs

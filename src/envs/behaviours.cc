@@ -13,8 +13,8 @@ namespace {
 
 class NoBehaviour final : public Task {
  public:
-  void reset(const mjModel*, const mjData*, Info&) override {}
-  double after_step(const mjModel*, const mjData*, Info&) override { return 0; }
+  void reset(const MimoCore&, Info&) override {}
+  double after_step(const MimoCore&, Info&) override { return 0; }
 };
 
 }  // namespace

@@ -17,8 +17,13 @@ class HandRegard final : public Task {
   // "left_eye_right_hand", "left_eye_left_hand") and, Cradle's extra, with either hand in view
   // ("right_eye_either_hand", "left_eye_either_hand").
   void declare(Info& info) override;
-  void reset(const mjModel* m, const mjData* d, Info& info) override;
-  double after_step(const mjModel* m, const mjData* d, Info& info) override;
+  void reset(const MimoCore& core, Info& info) override { reset(core.model(), core.data(), info); }
+  double after_step(const MimoCore& core, Info& info) override {
+    return after_step(core.model(), core.data(), info);
+  }
+  // The same on any model and data (the tests' inline models).
+  void reset(const mjModel* m, const mjData* d, Info& info);
+  double after_step(const mjModel* m, const mjData* d, Info& info);
   // The mean over the four eye-hand pairs of the fraction of steps in view.
   double score(const Info& info, int steps) const override;
 

@@ -20,8 +20,13 @@ class SelfTouch final : public Task {
   explicit SelfTouch(const mjModel* m);
   // Info: "right_hand_touches", "left_hand_touches" (geom ids in order of first contact).
   void declare(Info& info) override;
-  void reset(const mjModel* m, const mjData* d, Info& info) override;
-  double after_step(const mjModel* m, const mjData* d, Info& info) override;
+  void reset(const MimoCore& core, Info& info) override { reset(core.model(), core.data(), info); }
+  double after_step(const MimoCore& core, Info& info) override {
+    return after_step(core.model(), core.data(), info);
+  }
+  // The same on any model and data (the tests' inline models).
+  void reset(const mjModel* m, const mjData* d, Info& info);
+  double after_step(const mjModel* m, const mjData* d, Info& info);
   // (|right| + |left|) / 68.
   double score(const Info& info, int steps) const override;
 

@@ -1,13 +1,19 @@
-// A task measures (and may reward) what the body does; it never changes the physics
-// (dm_control's split). BabyBench behaviours return reward 0 and fill the info.
+// A task measures (and may reward) what the body does on the one MIMo env core (dm_control's
+// split: the core is the physics and the senses, the task the rest). BabyBench behaviours only
+// measure (reward 0); the sample tasks also set up each episode's start (a goal, start actions,
+// a ball to catch) and move head and eyes between physics and observation. Every hook but reset
+// and after_step has a default that does nothing.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
 #include <memory>
+#include <span>
 
 #include "core/config.h"
+#include "core/rng.h"
 #include "envs/env.h"
+#include "envs/mimo_core.h"
 
 namespace cradle::envs {
 
@@ -16,10 +22,26 @@ class Task {
   virtual ~Task() = default;
   // Once, when the env is built: the info keys the task writes.
   virtual void declare(Info& info) { (void)info; }
-  // At the start of an episode, after the start state is set.
-  virtual void reset(const mjModel* m, const mjData* d, Info& info) = 0;
-  // After each env step's physics; returns the reward.
-  virtual double after_step(const mjModel* m, const mjData* d, Info& info) = 0;
+  // At the start of an episode, from the env's start state: draws the goal (goal_size values,
+  // none for BabyBench) and sets up the episode's start on the body with the env's generator.
+  virtual void initialize_episode(MimoCore& core, Rng& rng, std::span<double> goal) {
+    (void)core, (void)rng, (void)goal;
+  }
+  // At the start of an episode, once the start state is set (the info is cleared).
+  virtual void reset(const MimoCore& core, Info& info) = 0;
+  // The action the physics gets (catch's jitter changes it).
+  virtual std::span<const double> before_step(std::span<const double> action, Rng& rng) {
+    (void)rng;
+    return action;
+  }
+  // After the step's physics, before the senses read it (head and eyes follow a target).
+  virtual void after_physics(MimoCore& core) { (void)core; }
+  // The task's observation values: those appended to proprioception and the achieved goal.
+  virtual void observe(const MimoCore& core, std::span<double> extra, std::span<double> achieved) {
+    (void)core, (void)extra, (void)achieved;
+  }
+  // After each env step's observation; writes the info and returns the reward.
+  virtual double after_step(const MimoCore& core, Info& info) = 0;
   // Score of an episode of `steps` env steps from its info (NaN: the task measures nothing).
   virtual double score(const Info& info, int steps) const;
 };

@@ -35,29 +35,52 @@ void check_env_memory(const envs::BabyBenchAssets& assets, int num_envs) {
 
 }  // namespace
 
-std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
-                                                              int threads, bool training,
-                                                              std::uint64_t seed, long continue_log,
-                                                              const EnvWrapper& wrap) {
+namespace {
+
+// The vector, and each env's BabyBench face (for the training log's bookkeeping).
+TrainingVector make_vector(const Config& config, int num_envs, int threads, bool training,
+                           std::uint64_t seed, long continue_log, const EnvWrapper& wrap) {
   using learn::ThreadedVecEnv;
   if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
   // One compiled model for all; one training log shared by all (it is thread-safe).
   const auto assets = envs::make_assets(config);
   check_env_memory(*assets, num_envs);
-  const std::shared_ptr<envs::TrainingLog> log =
-      training ? envs::start_training(*assets, continue_log) : nullptr;
+  TrainingVector out;
+  out.geom_count = assets->model->ngeom;
+  if (training) out.log = envs::start_training(*assets, continue_log);
   // The log takes each env's entries in env order after every step, whatever thread ran first.
-  if (log) log->set_slots(num_envs);
-  auto vec = std::make_unique<ThreadedVecEnv>(
+  if (out.log) out.log->set_slots(num_envs);
+  auto envs = std::make_shared<std::vector<envs::BabyBenchEnv*>>(num_envs);
+  out.vec = std::make_unique<ThreadedVecEnv>(
       num_envs,
       [&](int i) {
         auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
-        if (log) env->attach_log(log, i);
+        if (out.log) env->attach_log(out.log, i);
+        if (out.log && continue_log >= 0) env->skip_next_record();
+        (*envs)[i] = env.get();
         return wrap ? wrap(std::move(env)) : std::unique_ptr<envs::Env>(std::move(env));
       },
       threads);
-  if (log) vec->set_after_step([log] { log->commit(); });
-  return vec;
+  if (out.log) out.vec->set_after_step([log = out.log] { log->commit(); });
+  out.end_episodes = [envs] {
+    for (envs::BabyBenchEnv* env : *envs) env->end_episode();
+  };
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& config, int num_envs,
+                                                              int threads, bool training,
+                                                              std::uint64_t seed, long continue_log,
+                                                              const EnvWrapper& wrap) {
+  return make_vector(config, num_envs, threads, training, seed, continue_log, wrap).vec;
+}
+
+TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
+                                       std::uint64_t seed, long continue_log,
+                                       const EnvWrapper& wrap) {
+  return make_vector(config, num_envs, threads, /*training=*/true, seed, continue_log, wrap);
 }
 
 }  // namespace cradle::train

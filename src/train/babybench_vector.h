@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "core/config.h"
+#include "envs/training_log.h"
 #include "learn/vector_env.h"
 
 namespace cradle::train {
@@ -23,5 +24,21 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
                                                               std::uint64_t seed,
                                                               long continue_log = -1,
                                                               const EnvWrapper& wrap = nullptr);
+
+// A training vector and its training log, for the run's bookkeeping without knowing the family.
+struct TrainingVector {
+  std::unique_ptr<learn::ThreadedVecEnv> vec;
+  std::shared_ptr<envs::TrainingLog> log;  // shared by every env
+  int geom_count = 0;                      // the model's geoms (the log's geom ids are below)
+  // Records every env's current episode now, cut short (a checkpoint is an episode boundary).
+  std::function<void()> end_episodes;
+};
+
+// make_babybench_vec_env with training = true. continue_log >= 0 (a resumed run): the log holding
+// that many entries is continued and every env's first reset records nothing (the episode before
+// it was never this run's).
+TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
+                                       std::uint64_t seed, long continue_log = -1,
+                                       const EnvWrapper& wrap = nullptr);
 
 }  // namespace cradle::train

@@ -169,17 +169,14 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                           {"teacher", curriculum->teacher_dump()}});
     teacher_log->flush();
   };
-  auto vec = make_babybench_vec_env(config, options.envs, options.threads, /*training=*/true,
-                                    options.seed, kept_episodes, wrap);
-  std::vector<envs::BabyBenchEnv*> envs;
-  for (int i = 0; i < vec->num_envs(); ++i) {
-    if (options.randomize_start) vec->env(i).set_reset_options({{"randomize_start", 1}});
-    // The family's own: a resumed run's first reset ends no episode of this run's log.
-    auto* wrapped = dynamic_cast<CurriculumEnv*>(&vec->env(i));
-    envs.push_back(&dynamic_cast<envs::BabyBenchEnv&>(wrapped ? wrapped->inner() : vec->env(i)));
-    if (options.resume) envs.back()->skip_next_record();
+  // A resumed run's first resets end no episode of this run's log.
+  TrainingVector training = make_babybench_training(config, options.envs, options.threads,
+                                                    options.seed, kept_episodes, wrap);
+  std::unique_ptr<ThreadedVecEnv>& vec = training.vec;
+  for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
+    vec->env(i).set_reset_options({{"randomize_start", 1}});
   }
-  const std::shared_ptr<envs::TrainingLog> training_log = envs[0]->log();
+  const std::shared_ptr<envs::TrainingLog>& training_log = training.log;
   std::unique_ptr<intrinsic::Composite> reward;
   if (!options.intrinsic.empty()) {
     reward = intrinsic::parse_intrinsic(options.intrinsic);
@@ -219,7 +216,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // flushed, so the checkpoint's episode count is the log's, and the next learn() starts fresh
   // episodes exactly as a resumed run does.
   auto save_checkpoint = [&](const std::vector<fs::path>& files) {
-    for (envs::BabyBenchEnv* env : envs) env->end_episode();
+    training.end_episodes();
     training_log->flush();
     const RunState run{.steps = learner->steps(), .episodes = training_log->episodes()};
     for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
@@ -321,13 +318,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   }
   save_checkpoint(files);
   write_teacher_log(true);
-  for (envs::BabyBenchEnv* env : envs) env->close();
+  for (int i = 0; i < vec->num_envs(); ++i) vec->env(i).close();
   if (!rows.empty()) plot_curves(rows, dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
   if (fs::exists(log_file))
     result.training_score = eval::training_score(
-        config.behavior,
-        eval::read_training_log(log_file, config.behavior, envs[0]->model()->ngeom));
+        config.behavior, eval::read_training_log(log_file, config.behavior, training.geom_count));
 
   // The trained policy's evaluation, acting deterministically.
   if (options.eval_episodes > 0 && !(options.stop && options.stop->load())) {

@@ -35,7 +35,7 @@ TEST(Illustrate, BadFlagsAreOneLineErrors) {
        {"--env reach --algorithm HER", "--env fly --algorithm PPO", "--env reach --algorithm XYZ",
         "--env reach --algorithm PPO --load_model /no/such.ckpt",
         "--env reach --algorithm PPO --save_every 0", "--env reach --algorithm PPO --palm_up",
-        "--env standup --algorithm PPO --jitter"}) {
+        "--env standup --algorithm PPO --jitter", "--env reach --train_for 10"}) {
     const CliResult r = cradle_in(dir, std::string("illustrate ") + args);
     EXPECT_EQ(r.status, 1) << args;
     EXPECT_EQ(lines(r.out), 1) << args << ": " << r.out;
@@ -71,11 +71,31 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
                     (models / "model_2.ckpt").string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("the trained policy"), std::string::npos) << r.out;
+  // Without --algorithm the checkpoint's algorithm is taken.
+  r = cradle_in(dir, "illustrate --env reach --test_for 5 --save_model tiny --load_model " +
+                         (models / "model_2.ckpt").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("the trained policy"), std::string::npos) << r.out;
   // Another algorithm's model is refused.
   r = cradle_in(dir, "illustrate --env reach --algorithm A2C --test_for 5 --load_model " +
                          (models / "model_2.ckpt").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(lines(r.out), 1) << r.out;
+  fs::remove_all(dir);
+}
+
+// The reference's documented call without --algorithm and without a model tests random actions,
+// the same (seeded) episodes as with an algorithm named but no model.
+TEST(Illustrate, NoAlgorithmAndNoModelTestsRandomActions) {
+  const fs::path dir = cradle::test::fresh_dir("illustrate_random");
+  const CliResult r = cradle_in(dir, "illustrate --env catch --test_for 200 --seed 4");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("with random actions"), std::string::npos) << r.out;
+  const CliResult named = cradle_in(dir, "illustrate --env catch --test_for 200 --seed 4 "
+                                         "--algorithm SAC");
+  ASSERT_EQ(named.status, 0) << named.out;
+  EXPECT_EQ(r.out, named.out);
+  EXPECT_NE(r.out.find("test episodes: success rate"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 

@@ -1,44 +1,33 @@
 // Hostile but fair input to the `cradle` binary: every bad flag, seed, hyperparameter, config
 // file and training-log line is one line on stderr and exit 1, quickly.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;
-  std::string out;
+struct CliRun : cradle::test::RunResult {
   double seconds = 0;
 };
 
+// `cradle <args>` through the shared runner, with no input (a command that waited on stdin would
+// hang the test instead of failing it), timed.
 CliRun cradle(const std::string& args) {
   const auto start = std::chrono::steady_clock::now();
-  CliRun r;
-  FILE* pipe = popen((std::string(CRADLE_BINARY) + " " + args + " 2>&1 </dev/null").c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
+  CliRun r{cradle::test::run_cradle(args + " </dev/null")};
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
 
-fs::path temp_dir(const std::string& tag) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("cradle_robust_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path temp_dir(const std::string& tag) { return cradle::test::fresh_dir("robust_" + tag); }
 
 // Lines of output without the progress bar (its '[###...]' lines and carriage returns).
 int message_lines(const std::string& out) {

@@ -3,12 +3,18 @@
 #include "core/thread_pool.h"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include "core/error.h"
 
 namespace cradle {
 namespace {
@@ -82,4 +88,27 @@ TEST(ThreadPool, ExceptionsReachTheCaller) {
 }
 
 }  // namespace
+// A pool whose threads cannot start (here: every new thread's default stack is larger than the
+// address space, so pthread_create fails) reports one line instead of deadlocking; in a child
+// process, killed by an alarm if it hangs.
+TEST(ThreadPoolDeathTest, StartFailureIsOneLineErrorNotAHang) {
+  EXPECT_EXIT(
+      {
+        alarm(20);
+        pthread_attr_t attr;
+        pthread_attr_init(&attr);
+        pthread_attr_setstacksize(&attr, std::size_t{1} << 50);
+        pthread_setattr_default_np(&attr);
+        try {
+          ThreadPool pool(4);
+          std::_Exit(2);  // started: no failure to test
+        } catch (const UserError& e) {
+          const std::string message = e.what();
+          const bool one_line = message.find('\n') == std::string::npos;
+          std::_Exit(one_line && message.starts_with("cannot start 4 threads") ? 0 : 3);
+        }
+      },
+      ::testing::ExitedWithCode(0), "");
+}
+
 }  // namespace cradle

@@ -3,9 +3,12 @@
 // detector on rendered hand-regard views, parsing, and checkpoints.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -381,6 +384,58 @@ TEST(Rnd, CheckpointRestoresTheSameRewards) {
   show(vec, 0, {0.3, -0.3, 1, 1});
   EXPECT_DOUBLE_EQ(step(a, vec)[0], step(b, vec)[0]);
   std::filesystem::remove_all(dir);
+}
+
+// Two identical learned rewards trained alike save byte-identical files (LibTorch's own optimiser
+// format ordered the Adam states by tensor address), and a reward loaded from one continues
+// exactly: the same rewards after one more update (the Adam moments were restored too).
+template <typename Reward, typename Options>
+void expect_identical_saves_and_exact_continuation(const Options& options, Options other) {
+  FakeVec vec(1, state_space(4));
+  Reward a(1.0, options), c(1.0, options), b(1.0, other);
+  for (Reward* r : {&a, &b, &c}) r->bind(vec);
+  auto run = [&](Reward& r, int from, int steps) {
+    for (int t = from; t < from + steps; ++t) {
+      show(vec, 0, {std::sin(t * 1.0), std::cos(t * 0.7), 0.1 * t, 1});
+      step(r, vec);
+    }
+    r.update();
+  };
+  run(a, 0, 40);
+  run(c, 0, 40);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("cradle_intrinsic_bytes_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "a");
+  std::filesystem::create_directories(dir / "c");
+  a.save(dir / "a");
+  c.save(dir / "c");
+  const std::string pt = "intrinsic_" + std::string(a.name()) + ".pt";
+  auto bytes = [](const std::filesystem::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_FALSE(bytes(dir / "a" / pt).empty());
+  EXPECT_EQ(bytes(dir / "a" / pt), bytes(dir / "c" / pt)) << a.name();
+  b.load(dir / "a");
+  // A resumed run starts new episodes: no transition spans the load.
+  a.reset(vec);
+  b.reset(vec);
+  run(a, 40, 40);
+  run(b, 40, 40);
+  show(vec, 0, {0.3, -0.3, 1, 1});
+  EXPECT_EQ(step(a, vec), step(b, vec)) << a.name();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LearnedRewards, IdenticalRunsSaveIdenticalBytesAndContinueExactly) {
+  LearnedOptions other = small_learned();
+  other.seed = 99;  // different initial weights, replaced by the loaded ones
+  expect_identical_saves_and_exact_continuation<Rnd>(RndOptions{.learned = small_learned()},
+                                                     RndOptions{.learned = other});
+  expect_identical_saves_and_exact_continuation<Icm>(small_learned(), other);
+  expect_identical_saves_and_exact_continuation<Disagreement>(
+      DisagreementOptions{.learned = small_learned(), .models = 3},
+      DisagreementOptions{.learned = other, .models = 3});
 }
 
 TEST(Features, PoolsTouchAndImagesAndCopiesTheRest) {

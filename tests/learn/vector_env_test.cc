@@ -6,10 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/jsonl.h"
 #include "core/rng.h"
 #include "envs/babybench.h"
@@ -253,4 +256,33 @@ TEST(ThreadedVecEnv, TrainingWritesOneSharedLog) {
 }
 
 }  // namespace
+// A vector that cannot fit in memory is refused before any env is built, in one line saying how
+// many envs fit: that count's envs fit in 80 % of the physical memory and one more does not.
+TEST(ThreadedVecEnv, VectorBeyondMemoryIsRefusedWithTheCountThatFits) {
+  const int too_many = 10'000'000;  // at >= 1 MB of MuJoCo data each, beyond any machine
+  try {
+    train::make_babybench_vec_env(self_touch(20), too_many, 1, /*training=*/false, 0);
+    FAIL() << "no error for " << too_many << " envs";
+  } catch (const UserError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    double total_gb = 0, each_mb = 0, physical_gb = 0;
+    int fit = 0, asked = 0;
+    ASSERT_EQ(std::sscanf(message.c_str(),
+                          "%d envs need about %lf GB (%lf MB each), more than 80%% of this "
+                          "machine's %lf GB of memory; use at most %d envs",
+                          &asked, &total_gb, &each_mb, &physical_gb, &fit),
+              5)
+        << message;
+    EXPECT_EQ(asked, too_many);
+    const double physical_mb = static_cast<double>(sysconf(_SC_PHYS_PAGES)) *
+                               static_cast<double>(sysconf(_SC_PAGE_SIZE)) / 1e6;
+    EXPECT_NEAR(physical_gb * 1e3, physical_mb, 100);
+    EXPECT_GE(fit, 1);
+    // The printed sizes are rounded (MB to 1, GB to 0.1): allow that much.
+    EXPECT_LE(fit * (each_mb - 0.5), 0.8 * physical_mb) << message;
+    EXPECT_GT((fit + 1) * (each_mb + 0.5), 0.8 * physical_mb) << message;
+  }
+}
+
 }  // namespace cradle::learn

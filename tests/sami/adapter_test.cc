@@ -1,8 +1,11 @@
 // The thin adapter to today's envs::Env interface.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "envs/sami/sami_env.h"
 
 namespace cradle::envs {
@@ -30,6 +33,30 @@ TEST(SamiAdapter, ForwardsSpacesObservationsAndSuccess) {
   auto cheetah = make_sami_env("HalfCheetah", "moderate", 0);
   cheetah->reset(2);
   EXPECT_EQ(cheetah->observation().f64(0).size(), 18u);
+}
+
+// NaN and infinite actions are refused with the shared one-line error before any physics, for a
+// locomotion and a Panda env.
+TEST(SamiAdapter, NonFiniteActionsAreRefused) {
+  for (const char* name : {"HalfCheetah", "PandaPush"}) {
+    SCOPED_TRACE(name);
+    auto env = make_sami_env(name, name[0] == 'P' ? "train" : "moderate", 0);
+    env->reset(3);
+    for (double bad : {std::nan(""), double{INFINITY}, -double{INFINITY}}) {
+      std::vector<double> action(env->action_space().size(), 0.0);
+      action.back() = bad;
+      try {
+        env->step(action);
+        FAIL() << "no error for " << bad;
+      } catch (const UserError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("action " + std::to_string(action.size() - 1)), std::string::npos)
+            << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+      }
+    }
+    EXPECT_EQ(static_cast<SamiEnvAdapter&>(*env).sami().info().steps, 0);
+  }
 }
 
 }  // namespace

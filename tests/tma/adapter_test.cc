@@ -1,6 +1,9 @@
 // The cradle::envs::Env adapter: spaces, observation copy and the success / failure flags.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -50,6 +53,29 @@ TEST(TmaAdapter, TakesTaskParametersAsResetOptions) {
   EXPECT_THROW(parkour.set_reset_options({{"input_vector_0", 0}, {"input_vector_2", 0}}),
                UserError);
   EXPECT_THROW(parkour.set_reset_options({{"input_vector", 0}}), UserError);
+}
+
+// NaN and infinite actions are refused with the shared one-line error, before any physics.
+TEST(TmaAdapter, NonFiniteActionsAreRefused) {
+  TmaEnvAdapter env(tma::TmaOptions{.env = tma::EnvId::kStumpTracks, .body = "spider"});
+  env.reset(2);
+  const std::vector<double> before(env.observation().f64(0).begin(),
+                                   env.observation().f64(0).end());
+  for (double bad : {std::nan(""), double{INFINITY}, -double{INFINITY}}) {
+    std::vector<double> action(12, 0.0);
+    action[5] = bad;
+    try {
+      env.step(action);
+      FAIL() << "no error for " << bad;
+    } catch (const UserError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("action 5"), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+  EXPECT_EQ(env.env().episode_steps(), 0);
+  const auto after = env.observation().f64(0);
+  EXPECT_TRUE(std::equal(before.begin(), before.end(), after.begin()));
 }
 
 }  // namespace

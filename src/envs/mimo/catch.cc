@@ -58,40 +58,38 @@ const std::map<std::string, double> kSkin = {
     {"right_lfmetacarpal", 0.007},
 };
 
-class CatchEnv final : public MimoEnv {
+class Catch final : public SampleTask {
  public:
-  CatchEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
-      : MimoEnv(std::move(assets), seed),
-        tracking_(model()),
-        hand_(body_id(model(), "right_hand")),
-        ball_body_(body_id(model(), "target")),
-        ball_geom_(mj_name2id(model(), mjOBJ_GEOM, "target")),
-        ball_qpos_(qpos_address(model(), "target_joint")),
-        ball_dof_(model()->jnt_dofadr[mj_name2id(model(), mjOBJ_JOINT, "target_joint")]),
-        wrist_qpos_(qpos_address(model(), std::string("robot:") + kWristRotation)),
-        zero_(action_space().size(), 0.0),
-        gains_(action_space().size(), 1.0),
-        jittered_(action_space().size()) {
-    own_model();  // ball size, mass and gravity change per episode
-    sensing_.assign(model()->nbody, 0);
-    for (const auto& [body, spacing] : kSkin) sensing_[body_id(model(), body)] = 1;
+  Catch(MimoCore& core, const SampleOptions& options)
+      : options_(options),
+        model_(core.own_model()),  // ball size, mass and gravity change per episode
+        tracking_(model_),
+        hand_(body_id(model_, "right_hand")),
+        ball_body_(body_id(model_, "target")),
+        ball_geom_(mj_name2id(model_, mjOBJ_GEOM, "target")),
+        ball_qpos_(qpos_address(model_, "target_joint")),
+        ball_dof_(model_->jnt_dofadr[mj_name2id(model_, mjOBJ_JOINT, "target_joint")]),
+        wrist_qpos_(qpos_address(model_, std::string("robot:") + kWristRotation)),
+        zero_(core.action_space().size(), 0.0),
+        gains_(core.action_space().size(), 1.0),
+        jittered_(core.action_space().size()),
+        low_(core.action_space().low),
+        high_(core.action_space().high) {
+    sensing_.assign(model_->nbody, 0);
+    for (const auto& [body, spacing] : kSkin) sensing_[body_id(model_, body)] = 1;
   }
 
- private:
-  const double* ball() const { return data()->xpos + 3 * ball_body_; }
-  const double* hand() const { return data()->xpos + 3 * hand_; }
-
-  void reset_model() override {
-    mjModel* m = own_model();
-    mjData* dd = d();
+  void initialize_episode(MimoCore& core, Rng& rng, std::span<double>) override {
+    mjModel* m = model_;
+    mjData* d = core.data();
     // A new ball: drop point, radius and mass (solid sphere inertia).
     for (int i = 0; i < 3; ++i) {
-      dd->qpos[ball_qpos_ + i] = kBallPos[i] + rng().uniform(-kBallJitter[i], kBallJitter[i]);
+      d->qpos[ball_qpos_ + i] = kBallPos[i] + rng.uniform(-kBallJitter[i], kBallJitter[i]);
     }
-    mju_zero(dd->qvel + ball_dof_, 6);
-    if (assets().options.palm_up) dd->qpos[wrist_qpos_] = kPalmUpAngle;
-    radius_ = rng().uniform(kRadius[0], kRadius[1]);
-    const double mass = rng().uniform(kMass[0], kMass[1]);
+    mju_zero(d->qvel + ball_dof_, 6);
+    if (options_.palm_up) d->qpos[wrist_qpos_] = kPalmUpAngle;
+    radius_ = rng.uniform(kRadius[0], kRadius[1]);
+    const double mass = rng.uniform(kMass[0], kMass[1]);
     m->geom_size[3 * ball_geom_] = radius_;
     m->geom_rbound[ball_geom_] = radius_;
     m->body_mass[ball_body_] = mass;
@@ -99,83 +97,87 @@ class CatchEnv final : public MimoEnv {
       m->body_inertia[3 * ball_body_ + i] = 0.4 * mass * radius_ * radius_;
     // mj_setConst recomputes the mass-dependent constants from qpos0; the state is kept.
     sim::State state;
-    sim().save(state);
-    mj_setConst(m, dd);
-    sim().restore(state);
+    core.sim().save(state);
+    mj_setConst(m, d);
+    core.sim().restore(state);
     for (int i = 0; i < 3; ++i) aim_error_[i] = 0;
-    if (assets().options.position_inaccurate) {
-      for (double& e : aim_error_) e = rng().uniform(-kAimError, kAimError);
+    if (options_.position_inaccurate) {
+      for (double& e : aim_error_) e = rng.uniform(-kAimError, kAimError);
     }
     gain_steps_ = 0;
 
     // Let the hand settle without gravity, ball hovering; then the ball starts to fall.
     const double gravity = m->opt.gravity[2];
     m->opt.gravity[2] = 0;
-    sim().actuation().reset(dd);
-    sim().actuation().apply(zero_, dd);
-    for (int i = 0; i < kSettleSteps; ++i) raw_step();
+    core.sim().actuation().reset(d);
+    core.sim().actuation().apply(zero_, d);
+    for (int i = 0; i < kSettleSteps; ++i) core.raw_step();
     m->opt.gravity[2] = gravity;
     held_.fill(0);
-    step_callback();
-    mj_forward(m, dd);
+    after_physics(core);
+    mj_forward(m, d);
   }
 
-  std::span<const double> process_action(std::span<const double> action) override {
-    if (!assets().options.jitter) return action;
+  std::span<const double> before_step(std::span<const double> action, Rng& rng) override {
+    if (!options_.jitter) return action;
     if (--gain_steps_ <= 0) {
-      gain_steps_ = static_cast<int>(rng().uniform(kGainSteps[0], kGainSteps[1]));
-      for (double& g : gains_) g = rng().uniform(kGain[0], kGain[1]);
+      gain_steps_ = static_cast<int>(rng.uniform(kGainSteps[0], kGainSteps[1]));
+      for (double& g : gains_) g = rng.uniform(kGain[0], kGain[1]);
     }
-    const Box& space = action_space();
     for (size_t k = 0; k < jittered_.size(); ++k) {
-      jittered_[k] = std::clamp(action[k] * gains_[k], space.low[k], space.high[k]);
+      jittered_[k] = std::clamp(action[k] * gains_[k], low_[k], high_[k]);
     }
     return jittered_;
   }
 
   // Records whether the ball touches the right arm this step, and aims head and eyes at it.
-  void step_callback() override {
-    const mjModel* m = model();
+  void after_physics(MimoCore& core) override {
+    const mjModel* m = model_;
+    mjData* d = core.data();
     bool contact = false;
-    for (int i = 0; i < data()->ncon && !contact; ++i) {
-      const mjContact& c = data()->contact[i];
+    for (int i = 0; i < d->ncon && !contact; ++i) {
+      const mjContact& c = d->contact[i];
       const int other = c.geom1 == ball_geom_ ? c.geom2 : c.geom2 == ball_geom_ ? c.geom1 : -1;
       if (other < 0 || !sensing_[m->geom_bodyid[other]]) continue;
       mjtNum force[6];
-      mj_contactForce(m, data(), i, force);
+      mj_contactForce(m, d, i, force);
       contact = std::abs(force[0]) >= kMinForce;
     }
     held_[held_at_++ % kHoldSteps] = contact;
     in_contact_ = contact;
-    const double aim[3] = {ball()[0] + aim_error_[0], ball()[1] + aim_error_[1],
-                           ball()[2] + aim_error_[2]};
-    tracking_.aim(m, d(), aim);
+    const double* ball = d->xpos + 3 * ball_body_;
+    const double aim[3] = {ball[0] + aim_error_[0], ball[1] + aim_error_[1],
+                           ball[2] + aim_error_[2]};
+    tracking_.aim(m, d, aim);
   }
 
-  bool is_success() override {
-    return std::ranges::all_of(held_, [](char h) { return h; });
+  void observe(const MimoCore&, std::span<double> extra, std::span<double>) override {
+    extra[0] = radius_;
   }
 
-  bool is_failure() override {
+  double after_step(const MimoCore& core, Info& info) override {
+    const mjData* d = core.data();
+    const double* ball = d->xpos + 3 * ball_body_;
+    const double* hand = d->xpos + 3 * hand_;
     double v[3];
-    mju_sub3(v, ball(), hand());
-    return ball()[2] < hand()[2] - kDropHeight || mju_norm3(v) > kDropDistance;
-  }
-
-  double compute_reward() override {
+    mju_sub3(v, ball, hand);
+    const bool success = std::ranges::all_of(held_, [](char h) { return h; });
+    const bool failure = ball[2] < hand[2] - kDropHeight || mju_norm3(v) > kDropDistance;
+    set_outcome(info, success, failure);
     double reward = in_contact_ ? kContactReward : 0;
-    if (assets().options.action_penalty) reward -= kCostWeight * sim().actuation().cost();
-    if (failure()) reward -= kEndReward;
-    if (success()) reward += kEndReward;
+    if (options_.action_penalty) reward -= kCostWeight * core.sim().actuation().cost();
+    if (failure) reward -= kEndReward;
+    if (success) reward += kEndReward;
     return reward;
   }
 
-  void extra_observation(std::span<double> out) override { out[0] = radius_; }
-
+ private:
+  SampleOptions options_;
+  mjModel* model_;  // the core's own copy
   HeadTracking tracking_;
   int hand_, ball_body_, ball_geom_, ball_qpos_, ball_dof_, wrist_qpos_;
   std::vector<char> sensing_;
-  std::vector<double> zero_, gains_, jittered_;
+  std::vector<double> zero_, gains_, jittered_, low_, high_;
   int gain_steps_ = 0;
   std::array<char, kHoldSteps> held_{};
   int held_at_ = 0;
@@ -252,8 +254,8 @@ SampleDefinition catch_definition() {
       d->qpos[qpos_address(m, std::string("robot:") + joint)] = angle;
     }
   };
-  def.make = [](std::shared_ptr<const SampleAssets> assets, std::uint64_t seed) {
-    return std::unique_ptr<MimoEnv>(std::make_unique<CatchEnv>(std::move(assets), seed));
+  def.make = [](MimoCore& core, const SampleOptions& options) -> std::unique_ptr<Task> {
+    return std::make_unique<Catch>(core, options);
   };
   return def;
 }

@@ -10,25 +10,21 @@
 namespace cradle::envs {
 namespace {
 
-class DummyEnv final : public MimoEnv {
+// No task: reward 0, never a success or a failure.
+class NoTask final : public SampleTask {
  public:
-  using MimoEnv::MimoEnv;
-
- private:
-  void reset_model() override {}
-  double compute_reward() override { return 0; }
+  double after_step(const MimoCore&, Info&) override { return 0; }
 };
 
-std::unique_ptr<MimoEnv> make_dummy(std::shared_ptr<const SampleAssets> assets,
-                                    std::uint64_t seed) {
-  return std::make_unique<DummyEnv>(std::move(assets), seed);
+std::unique_ptr<Task> make_no_task(MimoCore&, const SampleOptions&) {
+  return std::make_unique<NoTask>();
 }
 
 SampleDefinition dummy(std::string name, int max_steps, model::MimoVersion version) {
   SampleDefinition def{
       .name = std::move(name), .max_episode_steps = max_steps, .vestibular = true, .vision = true};
   def.touch = senses::default_touch_scales(version, GroupFlags::all(true), 1.0);
-  def.make = make_dummy;
+  def.make = make_no_task;
   return def;
 }
 

@@ -13,53 +13,54 @@ constexpr double kKnockedOut = 0.01;              // m the ball must move for su
 constexpr double kTouchReward = 100;
 constexpr int kRandomResetSteps = 10;
 
-class ReachEnv final : public MimoEnv {
+class Reach final : public SampleTask {
  public:
-  ReachEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
-      : MimoEnv(std::move(assets), seed),
-        tracking_(model()),
-        target_body_(body_id(model(), "target")),
-        target_qpos_(qpos_address(model(), "target_joint")),
-        fingers_(body_id(model(), "right_fingers")),
-        random_action_(action_space().size()) {}
+  explicit Reach(MimoCore& core)
+      : tracking_(core.model()),
+        target_body_(body_id(core.model(), "target")),
+        target_qpos_(qpos_address(core.model(), "target_joint")),
+        fingers_(body_id(core.model(), "right_fingers")),
+        random_action_(core.action_space().size()) {}
 
- private:
-  const double* target_pos() const { return data()->xpos + 3 * target_body_; }
-
-  void reset_model() override {
+  void initialize_episode(MimoCore& core, Rng& rng, std::span<double>) override {
     // A few random arm movements, then the ball moved within reach; everything at rest.
-    const Box& space = action_space();
+    const Box& space = core.action_space();
+    const mjModel* m = core.model();
+    mjData* d = core.data();
     for (int i = 0; i < kRandomResetSteps; ++i) {
       for (size_t k = 0; k < random_action_.size(); ++k) {
-        random_action_[k] = rng().uniform(space.low[k], space.high[k]);
+        random_action_[k] = rng.uniform(space.low[k], space.high[k]);
       }
-      sim().actuation().apply(random_action_, d());
-      sim().actuation().substep(d());
-      raw_step();
-      step_callback();
+      core.sim().actuation().apply(random_action_, d);
+      core.sim().actuation().substep(d);
+      core.raw_step();
+      after_physics(core);
     }
-    double* ball = d()->qpos + target_qpos_;
-    ball[0] = kTarget[0] + rng().uniform(-0.1, 0);
-    ball[1] = kTarget[1] + rng().uniform(-0.2, 0.1);
-    ball[2] = kTarget[2] + rng().uniform(-0.1, 0);
-    mju_zero(d()->qvel, model()->nv);
-    mj_forward(model(), d());
-    mju_copy3(start_, target_pos());
+    double* ball = d->qpos + target_qpos_;
+    ball[0] = kTarget[0] + rng.uniform(-0.1, 0);
+    ball[1] = kTarget[1] + rng.uniform(-0.2, 0.1);
+    ball[2] = kTarget[2] + rng.uniform(-0.1, 0);
+    mju_zero(d->qvel, m->nv);
+    mj_forward(m, d);
+    mju_copy3(start_, target_pos(d));
   }
 
-  void step_callback() override { tracking_.aim(model(), d(), target_pos()); }
-
-  bool is_success() override {
-    double moved[3];
-    mju_sub3(moved, target_pos(), start_);
-    return mju_norm3(moved) > kKnockedOut;
+  void after_physics(MimoCore& core) override {
+    tracking_.aim(core.model(), core.data(), target_pos(core.data()));
   }
 
-  double compute_reward() override {
-    double v[3];
-    mju_sub3(v, data()->xpos + 3 * fingers_, target_pos());
-    return -mju_norm3(v) + (success() ? kTouchReward : 0);
+  double after_step(const MimoCore& core, Info& info) override {
+    const mjData* d = core.data();
+    double moved[3], v[3];
+    mju_sub3(moved, target_pos(d), start_);
+    const bool success = mju_norm3(moved) > kKnockedOut;
+    set_outcome(info, success, false);
+    mju_sub3(v, d->xpos + 3 * fingers_, target_pos(d));
+    return -mju_norm3(v) + (success ? kTouchReward : 0);
   }
+
+ private:
+  const double* target_pos(const mjData* d) const { return d->xpos + 3 * target_body_; }
 
   HeadTracking tracking_;
   int target_body_, target_qpos_, fingers_;
@@ -99,8 +100,8 @@ SampleDefinition reach_definition() {
     c.worlds.push_back(std::move(task));
     return c;
   };
-  def.make = [](std::shared_ptr<const SampleAssets> assets, std::uint64_t seed) {
-    return std::unique_ptr<MimoEnv>(std::make_unique<ReachEnv>(std::move(assets), seed));
+  def.make = [](MimoCore& core, const SampleOptions&) -> std::unique_ptr<Task> {
+    return std::make_unique<Reach>(core);
   };
   return def;
 }

@@ -164,8 +164,7 @@ std::shared_ptr<const SampleAssets> make_sample_assets(std::string_view name,
 
 std::unique_ptr<MimoEnv> make_sample_env(std::shared_ptr<const SampleAssets> assets,
                                          std::uint64_t seed) {
-  const SampleDefinition& def = assets->definition;
-  std::unique_ptr<MimoEnv> env = def.make(std::move(assets), seed);
+  auto env = std::make_unique<MimoEnv>(std::move(assets), seed);
   env->reset(seed);
   return env;
 }
@@ -175,162 +174,94 @@ std::unique_ptr<MimoEnv> make_sample_env(std::string_view name, const SampleOpti
   return make_sample_env(make_sample_assets(name, options), seed);
 }
 
-DictSpace sample_observation_space(const SampleAssets& assets, int proprio_size) {
-  const SampleDefinition& def = assets.definition;
-  // Keys in the reference's order: proprioception, touch, eyes, vestibular, goals.
-  DictSpace space;
-  space.entries.emplace_back(
-      MimoEnv::kProprioKey,
-      Box::unbounded({proprio_size + def.extra_observation}, DType::kFloat64));
-  if (assets.touch) space.entries.emplace_back(MimoEnv::kTouchKey, assets.touch->space());
-  if (def.vision) {
-    const Box eye = senses::Eyes::space_for(assets.options.vision_resolution);
-    space.entries.emplace_back(senses::Eyes::kLeftKey, eye);
-    space.entries.emplace_back(senses::Eyes::kRightKey, eye);
-  }
-  if (def.vestibular) {
-    space.entries.emplace_back(MimoEnv::kVestibularKey,
-                               Box::unbounded({senses::Vestibular::kSize}, DType::kFloat64));
-  }
-  if (assets.goals_in_observation) {
-    const Box goal = Box::unbounded({def.goal_size}, DType::kFloat64);
-    space.entries.emplace_back(MimoEnv::kAchievedKey, goal);
-    space.entries.emplace_back(MimoEnv::kDesiredKey, goal);
-  }
-  return space;
+void SampleTask::declare(Info& info) {
+  success_slot_ = info.declare("is_success", InfoType::kBool);
+  failure_slot_ = info.declare("is_failure", InfoType::kBool);
 }
+
+void SampleTask::set_outcome(Info& info, bool success, bool failure) const {
+  info.set(success_slot_, success);
+  info.set(failure_slot_, failure);
+}
+
+namespace {
+
+// The senses of a sample env: the task's, with the reference's proprioception.
+MimoSenses sample_senses(const SampleAssets& assets) {
+  const SampleDefinition& def = assets.definition;
+  return {.extra_proprio = def.extra_observation,
+          .touch = assets.touch.get(),
+          .vision_resolution = def.vision ? assets.options.vision_resolution : 0,
+          .vestibular = def.vestibular,
+          .goals = assets.goals_in_observation,
+          .goal_size = def.goal_size};
+}
+
+}  // namespace
 
 MimoEnv::MimoEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
     : assets_(std::move(assets)),
-      m_(assets_->model.get()),
-      sim_(m_, assets_->actuation, assets_->definition.frame_skip),
-      proprio_(m_, senses::ProprioOptions{}, sim_.actuation().observation_size()),
-      observation_space_(sample_observation_space(*assets_, proprio_.size())),
-      obs_(observation_space_),
-      proprio_index_(key_index(kProprioKey)),
-      touch_index_(key_index(kTouchKey)),
-      eye_left_index_(key_index(senses::Eyes::kLeftKey)),
-      eye_right_index_(key_index(senses::Eyes::kRightKey)),
-      vestibular_index_(key_index(kVestibularKey)),
-      achieved_index_(key_index(kAchievedKey)),
-      desired_index_(key_index(kDesiredKey)),
+      core_(assets_->model.get(), assets_->actuation, assets_->definition.frame_skip,
+            sample_senses(*assets_)),
+      task_(assets_->definition.make(core_, assets_->options)),
       goal_(assets_->definition.goal_size, 0.0),
-      success_slot_(info_.declare("is_success", InfoType::kBool)),
-      failure_slot_(info_.declare("is_failure", InfoType::kBool)),
       rng_(seed) {
-  const SampleDefinition& def = assets_->definition;
-  if (def.vision) eyes_ = std::make_unique<senses::Eyes>(m_, assets_->options.vision_resolution);
-  if (def.vestibular) vestibular_.emplace(m_);
-  sim_.restore(assets_->init);
+  task_->declare(info_);
+  success_slot_ = info_.find("is_success");
+  failure_slot_ = info_.find("is_failure");
+  core_.sim().restore(assets_->init);
 }
 
 MimoEnv::~MimoEnv() = default;
-
-mjModel* MimoEnv::own_model() {
-  if (!own_) {
-    own_.reset(mj_copyModel(nullptr, assets_->model.get()));
-    // The simulation moves onto the copy; its state carries over.
-    sim::State state;
-    sim_.save(state);
-    sim_ = sim::Sim(own_.get(), assets_->actuation, assets_->definition.frame_skip);
-    sim_.restore(state);
-    m_ = own_.get();
-  }
-  return own_.get();
-}
 
 const ObservationLayout* MimoEnv::layout(std::string_view key) const {
   return key == kTouchKey && assets_->touch ? &assets_->touch_layout : nullptr;
 }
 
-int MimoEnv::key_index(std::string_view key) const {
-  for (int i = 0; i < static_cast<int>(observation_space_.entries.size()); ++i) {
-    if (observation_space_.entries[i].first == key) return i;
-  }
-  return -1;
-}
-
 void MimoEnv::reset(std::optional<std::uint64_t> seed) {
   if (seed) rng_.seed_with(*seed);
-  // mj_resetData, actuation reset, new goal, then the task's reset from the start state.
-  sim_.reset();
-  sample_goal(goal_);
-  restore_init();
-  reset_model();
+  // mj_resetData and actuation reset, the start state, then the task's goal and start.
+  core_.sim().reset();
+  core_.sim().restore(assets_->init);
+  task_->initialize_episode(core_, rng_, goal_);
   steps_ = 0;
   info_.clear();
+  task_->reset(core_, info_);
   observe();
 }
 
-void MimoEnv::simulate(std::span<const double> action) {
-  sim::Actuation& actuation = sim_.actuation();
-  mjData* data = sim_.data();
-  actuation.apply(action, data);
-  for (int i = 0; i < assets_->definition.frame_skip; ++i) {
-    actuation.substep(data);
-    mj_step(m_, data);
-    mj_rnePostConstraint(m_, data);
-    substep_callback();
-  }
+void MimoEnv::observe() {
+  core_.observe();
+  const std::span<double> achieved = core_.achieved_goal();
+  task_->observe(core_, core_.extra_proprio(), achieved);
+  if (!achieved.empty()) std::ranges::copy(goal_, core_.desired_goal().begin());
 }
 
 StepResult MimoEnv::step(std::span<const double> action) {
   check_finite_actions(action);
-  const Clock::time_point start = Clock::now();
-  simulate(process_action(action));
-  step_callback();
-  profile_.physics += seconds(Clock::now() - start);
+  core_.step(task_->before_step(action, rng_), /*contact_forces=*/true);
+  task_->after_physics(core_);
   observe();
 
   const Clock::time_point task_start = Clock::now();
   info_.steps = steps_;
-  info_.set(success_slot_, is_success());
-  info_.set(failure_slot_, is_failure());
   StepResult result;
+  result.reward = task_->after_step(core_, info_);
   result.terminated = assets_->done_active && (success() || failure());
   ++steps_;
   const int limit = assets_->definition.max_episode_steps;
   result.truncated = limit > 0 && steps_ >= limit;
-  result.reward = compute_reward();
-  profile_.other += seconds(Clock::now() - task_start);
-  ++profile_.steps;
+  Profile& profile = core_.profile();
+  profile.other += seconds(Clock::now() - task_start);
+  ++profile.steps;
   return result;
-}
-
-void MimoEnv::observe() {
-  mjData* data = sim_.data();
-  Clock::time_point t = Clock::now();
-  auto lap = [&](double& bucket) {
-    const Clock::time_point now = Clock::now();
-    bucket += seconds(now - t);
-    t = now;
-  };
-  const std::span<double> vector = obs_.f64(proprio_index_);
-  proprio_.read(m_, data, sim_.actuation(), vector.first(proprio_.size()));
-  extra_observation(vector.subspan(proprio_.size()));
-  lap(profile_.proprio);
-  if (touch_index_ >= 0) {
-    assets_->touch->read(m_, data, obs_.f32(touch_index_));
-    lap(profile_.touch);
-  }
-  if (eyes_) {
-    eyes_->render(m_, data, obs_.u8(eye_left_index_), obs_.u8(eye_right_index_));
-    lap(profile_.vision);
-  }
-  if (vestibular_) {
-    vestibular_->read(data, obs_.f64(vestibular_index_));
-    lap(profile_.vestibular);
-  }
-  if (achieved_index_ >= 0) {
-    achieved_goal(obs_.f64(achieved_index_));
-    std::ranges::copy(goal_, obs_.f64(desired_index_).begin());
-  }
 }
 
 void MimoEnv::render(std::span<std::uint8_t> rgb) {
   const int size = assets_->options.render_size;
-  if (!view_) view_ = std::make_unique<senses::CameraRenderer>(m_, size, size);
-  view_->render(m_, sim_.data(), assets_->camera, size, size, rgb);
+  const mjModel* m = core_.model();
+  if (!view_) view_ = std::make_unique<senses::CameraRenderer>(m, size, size);
+  view_->render(m, mutable_data(), assets_->camera, size, size, rgb);
 }
 
 HeadTracking::HeadTracking(const mjModel* m)

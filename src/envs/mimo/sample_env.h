@@ -1,8 +1,9 @@
 // MIMo's sample environments (mimo_core.md §5-6): reach, standup, self-body, catch, benchmark and
-// showroom. The shared core is MimoEnv, the reference's MIMoEnv step loop over one compiled
-// scene; each task is one short file (envs/mimo/<task>.cc: scene, reset, reward, success, failure,
-// callbacks). What a task compiles to once (model, skin, start state) lives in SampleAssets and
-// is shared read-only by every env built from it.
+// showroom. MimoEnv runs the reference's MIMoEnv step loop on the one MIMo env core
+// (envs/mimo_core.h, shared with BabyBench); each task is a Task (envs/task.h) in one short file
+// (envs/mimo/<task>.cc: scene, start, reward, success, failure). What a task compiles to once
+// (model, skin, start state) lives in SampleAssets and is shared read-only by every env built
+// from it.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -20,16 +21,17 @@
 
 #include "core/config.h"
 #include "core/rng.h"
-#include "envs/babybench.h"
 #include "envs/env.h"
+#include "envs/mimo_core.h"
+#include "envs/task.h"
 #include "scene/compose.h"
-#include "senses/proprioception.h"
 #include "senses/touch.h"
-#include "senses/vestibular.h"
 #include "senses/vision.h"
 #include "sim/sim.h"
 
 namespace cradle::envs {
+
+class MimoEnv;
 
 // Constructor options of the sample envs; unset fields take the task's defaults.
 struct SampleOptions {
@@ -68,10 +70,9 @@ struct SampleDefinition {
   std::function<scene::Composition(const SampleOptions&)> scene;
   // Writes the start state into d (already reset and forwarded); the core saves it as `init`.
   std::function<void(const mjModel*, mjData*)> initial_state;
-  // Builds the task's env over compiled assets (the registry then resets it with the seed).
-  std::function<std::unique_ptr<class MimoEnv>(std::shared_ptr<const struct SampleAssets>,
-                                               std::uint64_t seed)>
-      make;
+  // The task of an env on its core (a task that changes the model per episode makes the core's
+  // copy here). The task declares "is_success" and "is_failure" and sets them every step.
+  std::function<std::unique_ptr<Task>(MimoCore& core, const SampleOptions& options)> make;
 };
 
 struct SampleAssets {
@@ -101,97 +102,75 @@ std::unique_ptr<MimoEnv> make_sample_env(std::shared_ptr<const SampleAssets> ass
 std::unique_ptr<MimoEnv> make_sample_env(std::string_view name, const SampleOptions& options = {},
                                          std::uint64_t seed = 0);
 
-// The base env: the reference's step order (mimo_core.md §5). step(): action -> frame_skip x
-// (actuation substep, mj_step, mj_rnePostConstraint, substep callback) -> step callback ->
-// observe -> success/failure -> terminated = done_active && (success || failure) -> truncated at
-// max_episode_steps -> reward. Randomness only from the env's own seeded generator.
-class MimoEnv : public Env {
+// A sample task: declares the reference's "is_success" and "is_failure" and sets them every step
+// (set_outcome, from after_step); its info holds nothing else.
+class SampleTask : public Task {
  public:
-  static constexpr const char* kProprioKey = "observation";
-  static constexpr const char* kTouchKey = "touch";
-  static constexpr const char* kVestibularKey = "vestibular";
-  static constexpr const char* kAchievedKey = "achieved_goal";
-  static constexpr const char* kDesiredKey = "desired_goal";
+  void declare(Info& info) override;
+  void reset(const MimoCore&, Info&) override {}
+
+ protected:
+  void set_outcome(Info& info, bool success, bool failure) const;
+
+ private:
+  int success_slot_ = -1, failure_slot_ = -1;
+};
+
+// A sample env: the reference's step order (mimo_core.md §5) on the MIMo env core, around its
+// task. step(): action (task's before_step) -> frame_skip x (actuation substep, mj_step,
+// mj_rnePostConstraint) -> task's after_physics -> observe -> the task's after_step (success,
+// failure, reward) -> terminated = done_active && (success || failure) -> truncated at
+// max_episode_steps. Randomness only from the env's own seeded generator.
+class MimoEnv final : public Env {
+ public:
+  static constexpr const char* kProprioKey = MimoCore::kProprioKey;
+  static constexpr const char* kTouchKey = MimoCore::kTouchKey;
+  static constexpr const char* kVestibularKey = MimoCore::kVestibularKey;
+  static constexpr const char* kAchievedKey = MimoCore::kAchievedKey;
+  static constexpr const char* kDesiredKey = MimoCore::kDesiredKey;
 
   MimoEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed);
   ~MimoEnv() override;
 
-  const DictSpace& observation_space() const override { return observation_space_; }
-  const Box& action_space() const override { return sim_.actuation().action_space(); }
+  const DictSpace& observation_space() const override { return core_.observation_space(); }
+  const Box& action_space() const override { return core_.action_space(); }
   void reset(std::optional<std::uint64_t> seed = std::nullopt) override;
   StepResult step(std::span<const double> action) override;
-  const ObservationBuffers& observation() const override { return obs_; }
+  const ObservationBuffers& observation() const override { return core_.observation(); }
   const Info& info() const override { return info_; }
   const ObservationLayout* layout(std::string_view key) const override;
 
   const SampleAssets& assets() const { return *assets_; }
   const SampleDefinition& definition() const { return assets_->definition; }
-  const mjModel* model() const { return m_; }
-  const mjData* data() const { return sim_.data(); }
+  const mjModel* model() const { return core_.model(); }
+  const mjData* data() const { return core_.data(); }
   // For tests that script states and for renderers (MuJoCo's scene update takes a non-const
   // mjData but does not change the state).
-  mjData* mutable_data() const { return const_cast<mjData*>(sim_.data()); }
+  mjData* mutable_data() const { return const_cast<mjData*>(core_.data()); }
   const senses::Touch* touch() const { return assets_->touch.get(); }
-  int key_index(std::string_view key) const;
+  int key_index(std::string_view key) const { return core_.key_index(key); }
   int episode_steps() const { return steps_; }
   // The task's flags of the last step (info "is_success", "is_failure").
   bool success() const { return info_.flag(success_slot_); }
   bool failure() const { return info_.flag(failure_slot_); }
-  const Profile& profile() const { return profile_; }
-  void clear_profile() { profile_ = {}; }
+  const Profile& profile() const { return core_.profile(); }
+  void clear_profile() { core_.profile() = {}; }
   // Renders the free view ("view" camera) at render_size^2 into rgb (row 0 at the top).
   void render(std::span<std::uint8_t> rgb);
   int render_size() const { return assets_->options.render_size; }
-
- protected:
-  // A private copy of the model for tasks that change it per episode (catch's ball size and mass,
-  // gravity during settling). Call from the task's constructor.
-  mjModel* own_model();
-  Rng& rng() { return rng_; }
-  sim::Sim& sim() { return sim_; }
-  mjData* d() { return sim_.data(); }
-  const std::vector<double>& goal() const { return goal_; }
-
-  // Task hooks, named as in the reference, plus process_action (catch's jitter).
-  virtual std::span<const double> process_action(std::span<const double> action) { return action; }
-  virtual void sample_goal(std::span<double> goal) { (void)goal; }
-  virtual void reset_model() = 0;  // after mj_resetData, actuation reset and restore(init)
-  virtual void substep_callback() {}
-  virtual void step_callback() {}
-  virtual bool is_success() { return false; }
-  virtual bool is_failure() { return false; }
-  virtual double compute_reward() = 0;  // after the flags of this step (success(), failure())
-  virtual void achieved_goal(std::span<double> out) { (void)out; }
-  virtual void extra_observation(std::span<double> out) { (void)out; }  // extra_observation values
-
-  // One raw physics step (no actuation substep, no callbacks), as the reference's settling.
-  void raw_step() { mj_step(m_, sim_.data()); }
-  // Restores the start state and recomputes derived quantities.
-  void restore_init() { sim_.restore(assets_->init); }
-  // Applies an action for one env step with the substep callbacks (no observation).
-  void simulate(std::span<const double> action);
 
  private:
   void observe();
 
   std::shared_ptr<const SampleAssets> assets_;
-  scene::ModelPtr own_;
-  const mjModel* m_;
-  sim::Sim sim_;
-  senses::Proprioception proprio_;
-  std::optional<senses::Vestibular> vestibular_;
-  std::unique_ptr<senses::Eyes> eyes_;
+  MimoCore core_;
+  std::unique_ptr<Task> task_;
   std::unique_ptr<senses::CameraRenderer> view_;
-  DictSpace observation_space_;
-  ObservationBuffers obs_;
-  const int proprio_index_, touch_index_, eye_left_index_, eye_right_index_, vestibular_index_,
-      achieved_index_, desired_index_;
   std::vector<double> goal_;
   Info info_;
-  const int success_slot_, failure_slot_;
+  int success_slot_ = -1, failure_slot_ = -1;
   Rng rng_;
   int steps_ = 0;
-  Profile profile_;
 };
 
 // Head and eyes aim at a point by setting their joint angles directly (reach and catch): the
@@ -206,9 +185,6 @@ class HeadTracking {
   int swivel_, tilt_, tilt_side_;  // qpos addresses
   std::array<int, 6> eyes_;        // left h/v/t, right h/v/t
 };
-
-// The observation space of a sample env whose proprioception has proprio_size values.
-DictSpace sample_observation_space(const SampleAssets& assets, int proprio_size);
 
 // Tasks (envs/mimo/<task>.cc).
 SampleDefinition reach_definition();

@@ -81,69 +81,69 @@ constexpr std::pair<const char*, double> kSitting[] = {
     {"left_toes", 0.24424},
 };
 
-class SelfBodyEnv final : public MimoEnv {
+class SelfBody final : public SampleTask {
  public:
-  SelfBodyEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
-      : MimoEnv(std::move(assets), seed), fingers_(body_id(model(), "right_fingers")) {
+  explicit SelfBody(const MimoCore& core) : fingers_(body_id(core.model(), "right_fingers")) {
+    const mjModel* m = core.model();
     for (int k = 0; k < static_cast<int>(std::size(kSkin)); ++k) {
-      skin_[k] = body_id(model(), kSkin[k].first);
+      skin_[k] = body_id(m, kSkin[k].first);
     }
-    arm_.assign(model()->nbody, 0);
-    for (const char* body : kRightArm) arm_[body_id(model(), body)] = 1;
+    arm_.assign(m->nbody, 0);
+    for (const char* body : kRightArm) arm_[body_id(m, body)] = 1;
+  }
+
+  void initialize_episode(MimoCore& core, Rng& rng, std::span<double> goal) override {
+    // A target drawn first (one-hot goal), then the start state at rest.
+    target_ = static_cast<int>(rng.uniform() * kTargets);
+    std::ranges::fill(goal, 0.0);
+    goal[target_] = 1;
+    mju_zero(core.data()->qvel, core.model()->nv);
+    mj_forward(core.model(), core.data());
+  }
+
+  void observe(const MimoCore& core, std::span<double>, std::span<double> achieved) override {
+    for (size_t k = 0; k < achieved.size(); ++k) achieved[k] = arm_touches(core, skin_[k]) ? 1 : 0;
+  }
+
+  double after_step(const MimoCore& core, Info& info) override {
+    const bool success = arm_touches(core, skin_[target_]);
+    set_outcome(info, success, false);
+    if (success) return kTouchReward;
+    if (feels(core, skin_[kTargets]) || feels(core, skin_[kTargets + 1])) {
+      const mjData* d = core.data();
+      double v[3];
+      mju_sub3(v, d->xpos + 3 * fingers_, d->xpos + 3 * skin_[target_]);
+      return -mju_norm3(v);
+    }
+    return kIdleReward;
   }
 
  private:
-  void sample_goal(std::span<double> goal) override {
-    target_ = static_cast<int>(rng().uniform() * kTargets);
-    std::ranges::fill(goal, 0.0);
-    goal[target_] = 1;
-  }
-
-  void reset_model() override {
-    mju_zero(d()->qvel, model()->nv);
-    mj_forward(model(), d());
-  }
-
   // Whether the right arm is in contact with body `b` (normal force above the touch threshold).
-  bool arm_touches(int b) const {
-    const mjModel* m = model();
-    const mjData* dd = data();
-    for (int i = 0; i < dd->ncon; ++i) {
-      const mjContact& c = dd->contact[i];
+  bool arm_touches(const MimoCore& core, int b) const {
+    const mjModel* m = core.model();
+    const mjData* d = core.data();
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
       const int b1 = m->geom_bodyid[c.geom1], b2 = m->geom_bodyid[c.geom2];
       if (!((b1 == b && arm_[b2]) || (b2 == b && arm_[b1]))) continue;
       mjtNum force[6];
-      mj_contactForce(m, dd, i, force);
+      mj_contactForce(m, d, i, force);
       if (std::abs(force[0]) >= 1e-9) return true;
     }
     return false;
   }
 
   // Whether any touch sensor of body b reads a force.
-  bool feels(int b) const {
-    const senses::Touch& skin = *touch();
+  bool feels(const MimoCore& core, int b) const {
+    const senses::Touch& skin = *core.touch();
     const int first = skin.first_sensor(b);
     if (first < 0) return false;
     const int n = skin.sensors_on_body(b) * skin.values_per_sensor();
-    const std::span<const float> values =
-        observation().f32(key_index(kTouchKey)).subspan(first * skin.values_per_sensor(), n);
+    const std::span<const float> values = core.observation()
+                                              .f32(core.key_index(MimoCore::kTouchKey))
+                                              .subspan(first * skin.values_per_sensor(), n);
     return std::ranges::any_of(values, [](float v) { return v != 0; });
-  }
-
-  bool is_success() override { return arm_touches(skin_[target_]); }
-
-  double compute_reward() override {
-    if (success()) return kTouchReward;
-    if (feels(skin_[kTargets]) || feels(skin_[kTargets + 1])) {
-      double v[3];
-      mju_sub3(v, data()->xpos + 3 * fingers_, data()->xpos + 3 * skin_[target_]);
-      return -mju_norm3(v);
-    }
-    return kIdleReward;
-  }
-
-  void achieved_goal(std::span<double> out) override {
-    for (int k = 0; k < kTargets; ++k) out[k] = arm_touches(skin_[k]) ? 1 : 0;
   }
 
   int fingers_;
@@ -196,8 +196,8 @@ SampleDefinition selfbody_definition() {
     for (int i = 0; i < kSettleSteps; ++i) mj_step(m, d);
     mju_zero(d->qvel, m->nv);
   };
-  def.make = [](std::shared_ptr<const SampleAssets> assets, std::uint64_t seed) {
-    return std::unique_ptr<MimoEnv>(std::make_unique<SelfBodyEnv>(std::move(assets), seed));
+  def.make = [](MimoCore& core, const SampleOptions&) -> std::unique_ptr<Task> {
+    return std::make_unique<SelfBody>(core);
   };
   return def;
 }

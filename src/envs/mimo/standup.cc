@@ -60,35 +60,33 @@ constexpr std::pair<const char*, double> kSitting[] = {
     {"left_toes", 0.0182025},
 };
 
-class StandupEnv final : public MimoEnv {
+class Standup final : public SampleTask {
  public:
-  StandupEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
-      : MimoEnv(std::move(assets), seed),
-        head_(body_id(model(), "head")),
-        zero_(action_space().size(), 0.0) {}
+  explicit Standup(MimoCore& core)
+      : head_(body_id(core.model(), "head")), zero_(core.action_space().size(), 0.0) {}
 
-  double head_height() const { return data()->xpos[3 * head_ + 2]; }
+  void initialize_episode(MimoCore& core, Rng& rng, std::span<double>) override {
+    // Every hinge angle jittered, at rest, then the body sags into a crouch under zero action.
+    const mjModel* m = core.model();
+    mjData* d = core.data();
+    for (int i = 7; i < m->nq; ++i) d->qpos[i] += rng.uniform(-kJointNoise, kJointNoise);
+    mju_zero(d->qvel, m->nv);
+    mj_forward(m, d);
+    core.sim().actuation().apply(zero_, d);
+    for (int i = 0; i < kSettleSteps; ++i) core.raw_step();
+  }
+
+  double after_step(const MimoCore& core, Info& info) override {
+    const mjModel* m = core.model();
+    const mjData* d = core.data();
+    const double head_height = d->xpos[3 * head_ + 2];
+    set_outcome(info, head_height >= kGoalHeight, false);
+    double effort = 0;
+    for (int u = 0; u < m->nu; ++u) effort += d->ctrl[u] * d->ctrl[u];
+    return head_height - kHeightOffset - kControlCost * effort;
+  }
 
  private:
-  void reset_model() override {
-    // Every hinge angle jittered, at rest, then the body sags into a crouch under zero action.
-    const mjModel* m = model();
-    for (int i = 7; i < m->nq; ++i) d()->qpos[i] += rng().uniform(-kJointNoise, kJointNoise);
-    mju_zero(d()->qvel, m->nv);
-    mj_forward(m, d());
-    sim().actuation().apply(zero_, d());
-    for (int i = 0; i < kSettleSteps; ++i) raw_step();
-  }
-
-  bool is_success() override { return head_height() >= kGoalHeight; }
-
-  double compute_reward() override {
-    const mjModel* m = model();
-    double effort = 0;
-    for (int u = 0; u < m->nu; ++u) effort += data()->ctrl[u] * data()->ctrl[u];
-    return head_height() - kHeightOffset - kControlCost * effort;
-  }
-
   int head_;
   std::vector<double> zero_;
 };
@@ -146,8 +144,8 @@ SampleDefinition standup_definition() {
       d->qpos[qpos_address(m, std::string("robot:") + joint)] = angle;
     }
   };
-  def.make = [](std::shared_ptr<const SampleAssets> assets, std::uint64_t seed) {
-    return std::unique_ptr<MimoEnv>(std::make_unique<StandupEnv>(std::move(assets), seed));
+  def.make = [](MimoCore& core, const SampleOptions&) -> std::unique_ptr<Task> {
+    return std::make_unique<Standup>(core);
   };
   return def;
 }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "envs/action_check.h"
+
 namespace cradle::envs {
 
 SamiEnvAdapter::SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env)
@@ -33,6 +35,7 @@ void SamiEnvAdapter::reset(std::optional<std::uint64_t> seed) {
 }
 
 StepResult SamiEnvAdapter::step(std::span<const double> action) {
+  check_finite_actions(action);
   const sami::StepResult r = env_->step(action);
   copy_observation();
   return {.reward = r.reward, .terminated = r.terminated, .truncated = r.truncated};

@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 
+#include "envs/action_check.h"
+
 namespace cradle::envs {
 namespace {
 
@@ -64,6 +66,7 @@ void TmaEnvAdapter::reset(std::optional<std::uint64_t> seed) {
 }
 
 StepResult TmaEnvAdapter::step(std::span<const double> action) {
+  check_finite_actions(action);
   const tma::TmaStep r = env_.step(action);
   info_.steps = env_.episode_steps() - 1;
   info_.set(success_slot_, r.success);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "learn/checkpoint.h"
 
 namespace cradle::learn::intrinsic {
 
@@ -54,9 +55,9 @@ void Disagreement::save_models(torch::serialize::OutputArchive& archive) const {
     models_[k]->save(model);
     archive.write("model" + std::to_string(k), model);
   }
-  torch::serialize::OutputArchive optimizer;
-  optimizer_->save(optimizer);
-  archive.write("optimizer", optimizer);
+  // In parameter order: LibTorch's own optimiser format keys its state by tensor address, so
+  // its order (and the checkpoint's bytes) changed from run to run.
+  write_optimizer(archive, "optimizer", *optimizer_);
 }
 
 void Disagreement::load_models(torch::serialize::InputArchive& archive) {
@@ -65,9 +66,7 @@ void Disagreement::load_models(torch::serialize::InputArchive& archive) {
     archive.read("model" + std::to_string(k), model);
     models_[k]->load(model);
   }
-  torch::serialize::InputArchive optimizer;
-  archive.read("optimizer", optimizer);
-  optimizer_->load(optimizer);
+  read_optimizer(archive, "optimizer", *optimizer_);
 }
 
 }  // namespace cradle::learn::intrinsic

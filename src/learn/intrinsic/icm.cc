@@ -1,5 +1,7 @@
 #include "learn/intrinsic/icm.h"
 
+#include "learn/checkpoint.h"
+
 namespace cradle::learn::intrinsic {
 
 void Icm::build(int features, int actions, at::Generator& gen) {
@@ -27,19 +29,19 @@ double Icm::train_step(const std::function<Batch()>& draw) {
 }
 
 void Icm::save_models(torch::serialize::OutputArchive& archive) const {
-  torch::serialize::OutputArchive model, optimizer;
+  torch::serialize::OutputArchive model;
   forward_->save(model);
-  optimizer_->save(optimizer);
   archive.write("forward", model);
-  archive.write("optimizer", optimizer);
+  // In parameter order: LibTorch's own optimiser format keys its state by tensor address, so
+  // its order (and the checkpoint's bytes) changed from run to run.
+  write_optimizer(archive, "optimizer", *optimizer_);
 }
 
 void Icm::load_models(torch::serialize::InputArchive& archive) {
-  torch::serialize::InputArchive model, optimizer;
+  torch::serialize::InputArchive model;
   archive.read("forward", model);
-  archive.read("optimizer", optimizer);
   forward_->load(model);
-  optimizer_->load(optimizer);
+  read_optimizer(archive, "optimizer", *optimizer_);
 }
 
 }  // namespace cradle::learn::intrinsic

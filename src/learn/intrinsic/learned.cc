@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "core/error.h"
+#include "learn/checkpoint.h"
 
 namespace cradle::learn::intrinsic {
 
@@ -167,10 +169,16 @@ void LearnedReward::save(const std::filesystem::path& dir) const {
   if (!bound_) throw UserError(std::string(name()) + ": save before bind");
   torch::serialize::OutputArchive archive;
   save_models(archive);
+  // The generator of the models' own draws (e.g. bootstrap masks), so a resumed run continues it.
+  write_generator(archive, "generator", gen_);
   archive.save_to(file(dir, ".pt").string());
+  // The minibatch generator's position too, so a resumed run draws the same minibatches.
+  std::ostringstream draw;
+  draw << draw_;
   const nlohmann::json state = {{"features", features_.size()},
                                 {"norm", norm_.to_json()},
-                                {"reward_std", reward_std_.to_json()}};
+                                {"reward_std", reward_std_.to_json()},
+                                {"draw", draw.str()}};
   std::ofstream out(file(dir, ".json"));
   out << state.dump() << "\n";
   if (!out) throw UserError("cannot write " + file(dir, ".json").string());
@@ -187,9 +195,18 @@ void LearnedReward::load(const std::filesystem::path& dir) {
     }
     norm_.from_json(state.at("norm"));
     reward_std_.from_json(state.at("reward_std"));
+    // Files of earlier builds have no generator state: their minibatches restart from the seed.
+    if (state.contains("draw")) {
+      std::istringstream draw(state.at("draw").get<std::string>());
+      draw >> draw_;
+      if (!draw) throw UserError("malformed " + file(dir, ".json").string() + ": bad 'draw' state");
+    }
     torch::serialize::InputArchive archive;
     archive.load_from(file(dir, ".pt").string());
     load_models(archive);
+    // Files of earlier builds have no generator state.
+    torch::Tensor generator;
+    if (archive.try_read("generator", generator)) gen_.set_state(generator);
   } catch (const nlohmann::json::exception& e) {
     throw UserError("malformed " + file(dir, ".json").string() + ": " + e.what());
   } catch (const c10::Error& e) {

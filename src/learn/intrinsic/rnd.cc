@@ -1,5 +1,7 @@
 #include "learn/intrinsic/rnd.h"
 
+#include "learn/checkpoint.h"
+
 namespace cradle::learn::intrinsic {
 
 void Rnd::build(int features, int, at::Generator& gen) {
@@ -29,23 +31,23 @@ double Rnd::train_step(const std::function<Batch()>& draw) {
 }
 
 void Rnd::save_models(torch::serialize::OutputArchive& archive) const {
-  torch::serialize::OutputArchive target, predictor, optimizer;
+  torch::serialize::OutputArchive target, predictor;
   target_->save(target);
   predictor_->save(predictor);
-  optimizer_->save(optimizer);
   archive.write("target", target);
   archive.write("predictor", predictor);
-  archive.write("optimizer", optimizer);
+  // In parameter order: LibTorch's own optimiser format keys its state by tensor address, so
+  // its order (and the checkpoint's bytes) changed from run to run.
+  write_optimizer(archive, "optimizer", *optimizer_);
 }
 
 void Rnd::load_models(torch::serialize::InputArchive& archive) {
-  torch::serialize::InputArchive target, predictor, optimizer;
+  torch::serialize::InputArchive target, predictor;
   archive.read("target", target);
   archive.read("predictor", predictor);
-  archive.read("optimizer", optimizer);
   target_->load(target);
   predictor_->load(predictor);
-  optimizer_->load(optimizer);
+  read_optimizer(archive, "optimizer", *optimizer_);
 }
 
 }  // namespace cradle::learn::intrinsic
