@@ -15,6 +15,7 @@ packages=(
   ccache
   libbox2d-dev libcairo2-dev libzip-dev libeigen3-dev
   python3-matplotlib python3-scipy python3-pandas
+  libgloo-dev
 )
 
 missing=()
