@@ -5,7 +5,10 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+// Gloo's half of c10d (Torch's CMake package defines it too).
+#ifndef USE_C10D_GLOO
 #define USE_C10D_GLOO 1
+#endif
 #include <torch/torch.h>
 
 #include <atomic>

@@ -31,6 +31,7 @@ class GradSync {
 
 // True when there is more than one rank.
 inline bool distributed(const GradSync* sync) { return sync != nullptr && sync->world_size() > 1; }
+inline int world_size(const GradSync* sync) { return sync != nullptr ? sync->world_size() : 1; }
 
 // Averages a float32 contiguous tensor (a packed gradient) over the ranks, in place.
 void average_gradients(GradSync* sync, const torch::Tensor& gradient);
