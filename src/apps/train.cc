@@ -120,6 +120,7 @@ void register_train(CLI::App& app) {
     }
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
                 r.steps_per_second, interrupted ? " — interrupted" : "");
+    if (group && group->rank() > 0) return;  // rank 0 reports the run's files
     std::printf("checkpoint: %s\n", r.checkpoint.c_str());
     if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
     if (r.evaluation) {
