@@ -17,6 +17,7 @@ packages=(
   python3-matplotlib python3-scipy python3-pandas
   slurm-wlm munge
   python3-torch  # only for the side-by-side benchmark bench/sami_update_torch.py
+  libgloo-dev
 )
 
 missing=()

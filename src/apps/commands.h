@@ -16,5 +16,6 @@ void register_illustrate(CLI::App& app);
 void register_tma(CLI::App& app);
 void register_tma_campaign(CLI::App& tma);  // under `tma`: campaign, analyze
 void register_sami(CLI::App& app);
+void register_launch(CLI::App& app);
 
 }  // namespace cradle::apps

@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_tma(app);
   cradle::apps::register_tma_campaign(*app.get_subcommand("tma"));
   cradle::apps::register_sami(app);
+  cradle::apps::register_launch(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

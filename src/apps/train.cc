@@ -11,6 +11,8 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "dist/process_group.h"
+#include "train/dist_sync.h"
 #include "train/trainer.h"
 
 namespace cradle::apps {
@@ -29,6 +31,8 @@ void register_train(CLI::App& app) {
     cradle::train::TrainOptions train;
     std::vector<std::string> hp;
     bool no_eval = false;
+    bool distributed = false;
+    dist::RendezvousFlags rendezvous;
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("train", "Train a policy with intrinsic motivation");
@@ -65,6 +69,23 @@ void register_train(CLI::App& app) {
   cmd->add_flag(
       "--no-eval-video", [opts](std::int64_t) { opts->train.eval_render = false; },
       "Evaluate without writing videos");
+  // Data-parallel training (docs/distributed.md): under `cradle launch`, torchrun-style
+  // variables, `srun`, or these flags.
+  CLI::Option* distributed = cmd->add_flag(
+      "--distributed", opts->distributed,
+      "Data-parallel over ranks (WORLD_SIZE/RANK/MASTER_ADDR/MASTER_PORT or Slurm's variables)");
+  cmd->add_option("--world-size", opts->rendezvous.world_size, "Ranks in all (with --distributed)")
+      ->check(CLI::Range(1, 1 << 20))
+      ->needs(distributed);
+  cmd->add_option("--rank", opts->rendezvous.rank, "This process's rank (with --distributed)")
+      ->check(CLI::Range(0, 1 << 20))
+      ->needs(distributed);
+  cmd->add_option("--master", opts->rendezvous.master, "Rank 0's host[:port] (with --distributed)")
+      ->needs(distributed);
+  cmd->add_option("--dist-timeout", opts->rendezvous.timeout_seconds,
+                  "Seconds to wait for the other ranks before failing")
+      ->check(CLI::Range(1, 86400))
+      ->needs(distributed);
   cmd->callback([opts, cmd] {
     // --resume continues the checkpoint's algorithm; an --algo that contradicts it is refused.
     if (opts->train.resume && cmd->get_option("--algo")->count() == 0) {
@@ -80,10 +101,29 @@ void register_train(CLI::App& app) {
       opts->train.hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
     std::signal(SIGINT, on_interrupt);
+    if (opts->distributed) std::signal(SIGTERM, on_interrupt);  // srun and launch stop with it
     opts->train.stop = &interrupted;
-    const train::TrainResult r = train::train(config, opts->train);
+    std::unique_ptr<dist::ProcessGroup> group;
+    if (opts->distributed) {
+      group = std::make_unique<dist::ProcessGroup>(
+          dist::resolve_rendezvous(opts->rendezvous, dist::process_env()));
+      opts->train.sync = std::make_shared<train::DistSync>(*group);
+    }
+    train::TrainResult r;
+    try {
+      r = train::train(config, opts->train);
+    } catch (const std::exception& e) {
+      if (group) group->announce_failure(e.what());  // the other ranks name this one
+      throw;
+    }
+    if (group) {
+      std::printf("rank %d of %d: parameter hash %016llx; %ld collectives, %.2f s\n", group->rank(),
+                  group->world_size(), static_cast<unsigned long long>(r.parameter_hash),
+                  group->collectives(), group->collective_seconds());
+    }
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
                 r.steps_per_second, interrupted ? " — interrupted" : "");
+    if (group && group->rank() > 0) return;  // rank 0 reports the run's files
     std::printf("checkpoint: %s\n", r.checkpoint.c_str());
     if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
     if (r.evaluation) {

@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
+#include "learn/grad_sync.h"
 #include "learn/networks.h"
 #include "learn/preprocess.h"
 #include "learn/rollout.h"
@@ -77,7 +78,11 @@ class A2c final : public Learner {
                        .weight_decay(0)),
         buffer_(config_.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
         collector_(env, pipeline_, options.reward_hook),
-        scratch_(ObsBatch::zeros(pipeline_.shape(), 1)) {}
+        scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
+        sync_(options.sync) {
+    // Data-parallel: every rank starts from rank 0's parameters.
+    broadcast_tensor(sync_.get(), parameters_.tensor());
+  }
 
   std::string_view algorithm() const override { return "a2c"; }
   long steps() const override { return steps_; }
@@ -103,7 +108,8 @@ class A2c final : public Learner {
       // Collect a rollout with the current policy, then n-step advantages and value targets.
       const Clock::time_point collect_start = Clock::now();
       collector_.collect(policy_, generator_, buffer_);
-      steps_ += buffer_.rows();
+      steps_ += static_cast<long>(buffer_.rows()) * world_size(sync_.get());  // every rank's
+      pipeline_.merge_statistics(sync_.get());
       buffer_.compute_returns_and_advantages(config_.gamma, config_.gae_lambda);
 
       // One gradient step on the whole rollout.
@@ -140,7 +146,10 @@ class A2c final : public Learner {
     steps_ = load_policy_checkpoint(file, "a2c", settings_.observation, *policy_, optimizer_,
                                     pipeline_, generator_)
                  .steps;
+    offset_generator(sync_.get(), generator_);
   }
+
+  std::uint64_t parameter_hash() const override { return tensor_hash({parameters_.tensor()}); }
 
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
            bool deterministic) override {
@@ -151,7 +160,15 @@ class A2c final : public Learner {
  private:
   std::map<std::string, double> update() {
     const torch::Tensor rows = buffer_.valid_rows();
-    if (rows.size(0) == 0) return {};
+    // Data-parallel: a rank without a transition still joins the all-reduce, with a zero gradient.
+    if (agree_max(sync_.get(), static_cast<double>(rows.size(0))) == 0) return {};
+    if (rows.size(0) == 0) {
+      parameters_.zero_grad();
+      average_gradients(sync_.get(), parameters_.tensor().grad());
+      torch::nn::utils::clip_grad_norm_(parameters_.tensor(), config_.max_grad_norm);
+      optimizer_.step();
+      return {};
+    }
     const ObsBatch observations = buffer_.observations.select(rows);
     const torch::Tensor actions = buffer_.actions.index_select(0, rows);
     const torch::Tensor returns = buffer_.returns.index_select(0, rows);
@@ -172,6 +189,7 @@ class A2c final : public Learner {
 
     parameters_.zero_grad();
     total.backward();
+    average_gradients(sync_.get(), parameters_.tensor().grad());
     torch::nn::utils::clip_grad_norm_(parameters_.tensor(), config_.max_grad_norm);
     optimizer_.step();
 
@@ -192,7 +210,8 @@ class A2c final : public Learner {
   torch::optim::RMSprop optimizer_;
   RolloutBuffer buffer_;
   RolloutCollector collector_;
-  ObsBatch scratch_;  // one row, for act()
+  ObsBatch scratch_;                      // one row, for act()
+  const std::shared_ptr<GradSync> sync_;  // null: alone
   long steps_ = 0;
 };
 

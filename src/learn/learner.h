@@ -23,6 +23,8 @@
 
 namespace cradle::learn {
 
+class GradSync;  // learn/grad_sync.h
+
 // Progress, reported after every rollout and its update (off-policy: every report_every steps).
 struct TrainStats {
   long steps = 0;    // env steps so far (vector steps x num_envs), counting earlier runs resumed
@@ -69,6 +71,9 @@ struct LearnerOptions {
   // LibTorch threads during gradient updates, while the envs wait. 0: every core for policies
   // with image inputs, whose convolutions scale, and torch_threads for vector-only policies.
   int update_threads = 0;
+  // A data-parallel run's ranks (learn/grad_sync.h); null: this process trains alone. PPO, A2C
+  // and SAC average their gradients over it and merge their observation statistics.
+  std::shared_ptr<GradSync> sync;
 };
 
 class Learner {
@@ -98,6 +103,9 @@ class Learner {
                    bool deterministic) = 0;
   // Every hyperparameter as "name = value" lines (what checkpoints store).
   virtual std::string config_text() const = 0;
+  // A hash of the trained parameters (learn/grad_sync.h tensor_hash), equal on every rank of a
+  // data-parallel run; 0 when the learner does not compute one.
+  virtual std::uint64_t parameter_hash() const { return 0; }
 };
 
 // What a checkpoint says about itself, read without building a learner (e.g. to pick the

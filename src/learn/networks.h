@@ -78,6 +78,7 @@ class PackedParameters {
  public:
   explicit PackedParameters(torch::nn::Module& module);
   torch::Tensor& tensor() { return packed_; }
+  const torch::Tensor& tensor() const { return packed_; }
   void zero_grad() { grad_.zero_(); }
 
  private:

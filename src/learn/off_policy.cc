@@ -117,7 +117,8 @@ OffPolicyLearner::OffPolicyLearner(std::string algorithm, VecEnv& env,
               pipeline_.shape(), env.action_space().size()),
       collector_(env, pipeline_, options.reward_hook),
       scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
-      update_threads_(update_threads(options, pipeline_.shape())) {}
+      update_threads_(update_threads(options, pipeline_.shape())),
+      sync_(options.sync) {}
 
 void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   const Clock::time_point start = Clock::now();
@@ -129,6 +130,13 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   double collect_seconds = 0, update_seconds = 0;  // since the last report
   std::vector<long> episode_length(envs, 0);       // episode_train_freq: steps per env
   std::vector<std::uint8_t> episode_ended(envs, 0);
+  // Episode-end updates differ per rank, and every update is a collective: refused together.
+  if (config_.episode_train_freq > 0 && distributed(sync_.get()))
+    throw UserError("episode_train_freq > 0 cannot run distributed (ranks would update a different "
+                    "number of times); use train_freq/gradient_steps");
+  // Data-parallel: every rank continues from rank 0's networks.
+  for (const auto& [key, module] : modules_) broadcast_module(sync_.get(), *module);
+  for (const auto& [key, tensor] : tensors_) broadcast_tensor(sync_.get(), *tensor);
   while (steps_ < total_steps) {
     // Act: uniformly at random until learning_starts, then the algorithm's exploration.
     const Clock::time_point collect_start = Clock::now();
@@ -140,7 +148,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
       actions = policy_action(collector_.observation(), /*deterministic=*/false);
     }
     collector_.step(actions, buffer_);
-    steps_ += envs;
+    steps_ += static_cast<long>(envs) * world_size(sync_.get());  // every rank's
     ++vector_steps_;
     const Clock::time_point update_start = Clock::now();
     collect_seconds += std::chrono::duration<double>(update_start - collect_start).count();
@@ -161,7 +169,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
         episode_ended[e] = 1;
       }
     }
-    if (updates > 0 && buffer_.size() > config_.learning_starts) {
+    if (updates > 0 && ready_to_train()) {
       const ScopedTorchThreads threads(update_threads_);
       for (int g = 0; g < updates; ++g) {
         ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
@@ -173,6 +181,7 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();
 
     if (vector_steps_ % config_.report_every != 0 && steps_ < total_steps) continue;
+    pipeline_.merge_statistics(sync_.get());
     TrainStats stats{.steps = steps_};
     for (const auto& [name, record] : records_) stats.losses[name] = record.first / record.second;
     records_.clear();
@@ -189,6 +198,24 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
     stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
     if (on_progress && !on_progress(stats)) break;
   }
+}
+
+bool OffPolicyLearner::ready_to_train() {
+  if (!distributed(sync_.get())) return buffer_.size() > config_.learning_starts;
+  if (!ready_) {
+    const double smallest = -agree_max(sync_.get(), -static_cast<double>(buffer_.size()));
+    ready_ = smallest > static_cast<double>(config_.learning_starts);
+  }
+  return ready_;
+}
+
+std::uint64_t OffPolicyLearner::parameter_hash() const {
+  std::vector<torch::Tensor> tensors;
+  for (const auto& [key, module] : modules_) {
+    for (const torch::Tensor& p : module->parameters()) tensors.push_back(p);
+  }
+  for (const auto& [key, tensor] : tensors_) tensors.push_back(*tensor);
+  return tensor_hash(tensors);
 }
 
 void OffPolicyLearner::record(const std::string& name, double value) {
@@ -263,6 +290,7 @@ void OffPolicyLearner::load(const std::filesystem::path& file) {
         updates_ = counters[1].item<long>();
       });
   steps_ = info.steps;
+  offset_generator(sync_.get(), generator_);
 }
 
 }  // namespace cradle::learn

@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "learn/grad_sync.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/networks.h"
@@ -135,6 +136,7 @@ class OffPolicyLearner : public Learner {
   void load(const std::filesystem::path& file) override;
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
            bool deterministic) override;
+  std::uint64_t parameter_hash() const override;
 
  protected:
   // Throws UserError for an action space without finite bounds or a replay buffer too large
@@ -160,8 +162,14 @@ class OffPolicyLearner : public Learner {
   const ObsShape& shape() const { return pipeline_.shape(); }
   int action_size() const { return env_.action_space().size(); }
   at::Generator& generator() { return generator_; }
+  // The data-parallel ranks (null: alone); an algorithm averages every gradient over them.
+  GradSync* sync() const { return sync_.get(); }
 
  private:
+  // Whether to train at this step: the buffer holds more than learning_starts transitions (in a
+  // data-parallel run, every rank's buffer, so that all start together).
+  bool ready_to_train();
+
   const std::string algorithm_;
   VecEnv& env_;
   const OffPolicyConfig config_;
@@ -173,6 +181,8 @@ class OffPolicyLearner : public Learner {
   TransitionCollector collector_;
   ObsBatch scratch_;  // one row, for act()
   const int update_threads_;
+  const std::shared_ptr<GradSync> sync_;
+  bool ready_ = false;  // data-parallel: every rank's buffer passed learning_starts
   long steps_ = 0, vector_steps_ = 0, updates_ = 0;
   std::map<std::string, std::pair<double, long>> records_;  // sum and count since the report
   std::vector<std::pair<std::string, torch::nn::Module*>> modules_;

@@ -19,6 +19,7 @@
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
+#include "learn/grad_sync.h"
 #include "learn/networks.h"
 #include "learn/preprocess.h"
 #include "learn/rollout.h"
@@ -92,7 +93,10 @@ class Ppo final : public Learner {
         buffer_(config_.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
         collector_(env, pipeline_, options.reward_hook),
         scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
-        update_threads_(update_threads(options, pipeline_.shape())) {
+        update_threads_(update_threads(options, pipeline_.shape())),
+        sync_(options.sync) {
+    // Data-parallel: every rank starts from rank 0's parameters.
+    broadcast_tensor(sync_.get(), parameters_.tensor());
     // A minibatch cannot be larger than the rollout it is drawn from.
     const long rollout = static_cast<long>(config_.n_steps) * env.num_envs();
     if (config_.batch_size > rollout) {
@@ -121,7 +125,8 @@ class Ppo final : public Learner {
       // Collect a rollout with the current policy, then GAE advantages and value targets.
       const Clock::time_point collect_start = Clock::now();
       collector_.collect(policy_, generator_, buffer_);
-      steps_ += buffer_.rows();
+      steps_ += static_cast<long>(buffer_.rows()) * world_size(sync_.get());  // every rank's
+      pipeline_.merge_statistics(sync_.get());
       buffer_.compute_returns_and_advantages(config_.gamma, config_.gae_lambda);
 
       // Optimise the clipped surrogate on it.
@@ -153,7 +158,10 @@ class Ppo final : public Learner {
     steps_ = load_policy_checkpoint(file, "ppo", settings_.observation, *policy_, optimizer_,
                                     pipeline_, generator_)
                  .steps;
+    offset_generator(sync_.get(), generator_);
   }
+
+  std::uint64_t parameter_hash() const override { return tensor_hash({parameters_.tensor()}); }
 
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
            bool deterministic) override {
@@ -166,13 +174,20 @@ class Ppo final : public Learner {
   std::map<std::string, double> update() {
     const torch::Tensor rows = buffer_.valid_rows();
     const long n = rows.size(0);
+    // Data-parallel: every rank takes as many minibatches as the rank with the most valid rows
+    // (the others wrap around their shuffled rows), so the gradient all-reduces pair up.
+    const long rows_per_epoch = static_cast<long>(agree_max(sync_.get(), static_cast<double>(n)));
+    if (rows_per_epoch == 0) return {};
+    if (n == 0) throw UserError("ppo: a rank's rollout holds no transition: raise n_steps");
     double policy_loss_sum = 0, value_loss_sum = 0, kl_sum = 0, clip_sum = 0, loss = 0;
     long minibatches = 0;
     bool keep_going = true;
     for (int epoch = 0; epoch < config_.n_epochs && keep_going; ++epoch) {
-      const torch::Tensor order = rows.index_select(0, torch::randperm(n, generator_));
-      for (long begin = 0; begin < n; begin += config_.batch_size) {
-        const torch::Tensor index = order.slice(0, begin, std::min(n, begin + config_.batch_size));
+      torch::Tensor order = rows.index_select(0, torch::randperm(n, generator_));
+      if (rows_per_epoch > n) order = order.repeat({(rows_per_epoch + n - 1) / n});
+      for (long begin = 0; begin < rows_per_epoch; begin += config_.batch_size) {
+        const torch::Tensor index =
+            order.slice(0, begin, std::min(rows_per_epoch, begin + config_.batch_size));
         const ObsBatch observations = buffer_.observations.select(index);
         const torch::Tensor actions = buffer_.actions.index_select(0, index);
         const torch::Tensor old_log_probs = buffer_.log_probs.index_select(0, index);
@@ -207,7 +222,11 @@ class Ppo final : public Learner {
             policy_loss - config_.ent_coef * entropy + config_.vf_coef * value_loss;
 
         // Approximate KL(old || new) = E[(r - 1) - log r] (Schulman's low-variance estimator).
-        const double approx_kl = ((ratio - 1) - log_ratio).mean().item<double>();
+        // Data-parallel: the ranks' mean, so that every rank stops at the same minibatch.
+        const double approx_kl =
+            config_.target_kl > 0
+                ? agree_mean(sync_.get(), ((ratio - 1) - log_ratio).mean().item<double>())
+                : ((ratio - 1) - log_ratio).mean().item<double>();
         if (config_.target_kl > 0 && approx_kl > 1.5 * config_.target_kl) {
           keep_going = false;
           break;
@@ -215,6 +234,7 @@ class Ppo final : public Learner {
 
         parameters_.zero_grad();
         total.backward();
+        average_gradients(sync_.get(), parameters_.tensor().grad());
         torch::nn::utils::clip_grad_norm_(parameters_.tensor(), config_.max_grad_norm);
         optimizer_.step();
 
@@ -260,6 +280,7 @@ class Ppo final : public Learner {
   RolloutCollector collector_;
   ObsBatch scratch_;  // one row, for act()
   const int update_threads_;
+  const std::shared_ptr<GradSync> sync_;  // null: alone
   long steps_ = 0;
 };
 

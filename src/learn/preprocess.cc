@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/error.h"
+#include "learn/grad_sync.h"
 #include "learn/vec_env.h"
 
 namespace cradle::learn {
@@ -88,7 +89,12 @@ void TouchPooling::pool(std::span<const float> raw, std::span<float> out) const 
 // Running mean and variance
 
 RunningMeanStd::RunningMeanStd(int size)
-    : mean_(size, 0.0), var_(size, 1.0), batch_mean_(size), batch_var_(size) {}
+    : mean_(size, 0.0),
+      var_(size, 1.0),
+      merged_mean_(mean_),
+      merged_var_(var_),
+      batch_mean_(size),
+      batch_var_(size) {}
 
 void RunningMeanStd::update(std::span<const float> batch, int rows) {
   const int n = size();
@@ -133,6 +139,37 @@ void RunningMeanStd::set(std::vector<double> mean, std::vector<double> var, doub
   mean_ = std::move(mean);
   var_ = std::move(var);
   count_ = count;
+  merged_mean_ = mean_;
+  merged_var_ = var_;
+  merged_count_ = count_;
+}
+
+void RunningMeanStd::merge(GradSync* sync) {
+  if (!distributed(sync)) return;
+  // Each rank holds G (the last merge, the same everywhere) plus its own new observations. Sum
+  // over the ranks the count, and the first and second moments around G's mean (stable for
+  // large counts); G then counts world_size times, so world_size - 1 copies are taken out.
+  const int n = size();
+  const double copies = sync->world_size() - 1;
+  sums_.assign(1 + 2 * static_cast<size_t>(n), 0.0);
+  sums_[0] = count_;
+  for (int j = 0; j < n; ++j) {
+    const double d = mean_[j] - merged_mean_[j];
+    sums_[1 + j] = count_ * d;
+    sums_[1 + n + j] = count_ * (var_[j] + d * d);
+  }
+  sync->all_reduce_sum(sums_);
+  const double total = sums_[0] - copies * merged_count_;
+  for (int j = 0; j < n; ++j) {
+    const double shift = sums_[1 + j] / total;
+    const double m2 = sums_[1 + n + j] - copies * merged_count_ * merged_var_[j];
+    mean_[j] = merged_mean_[j] + shift;
+    var_[j] = std::max(0.0, m2 / total - shift * shift);
+  }
+  count_ = total;
+  merged_mean_ = mean_;
+  merged_var_ = var_;
+  merged_count_ = count_;
 }
 
 // ---------------------------------------------------------------------------------------------

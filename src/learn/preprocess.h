@@ -26,6 +26,7 @@
 namespace cradle::learn {
 
 class VecEnv;
+class GradSync;
 
 struct ObservationConfig {
   bool normalize_observations = true;  // running mean/std normalisation (VecNormalize norm_obs)
@@ -82,10 +83,17 @@ class RunningMeanStd {
   const std::vector<double>& var() const { return var_; }
   double count() const { return count_; }
   void set(std::vector<double> mean, std::vector<double> var, double count);
+  // Data-parallel: every rank's observations since the last merge added to the statistics of
+  // the last merge (which every rank shares), so every rank ends with the statistics of all the
+  // ranks' observations. Nothing without a sync or alone.
+  void merge(GradSync* sync);
 
  private:
   std::vector<double> mean_, var_;
   double count_ = kInitialCount;
+  std::vector<double> merged_mean_, merged_var_;  // at the last merge (or set)
+  double merged_count_ = kInitialCount;
+  std::vector<double> sums_;                    // scratch of merge
   std::vector<double> batch_mean_, batch_var_;  // scratch
 };
 
@@ -138,6 +146,10 @@ class ObservationPipeline {
   void raw_vector(const envs::ObservationBuffers& observation, std::span<float> out) const;
 
   const RunningMeanStd& normalizer() const { return normalizer_; }
+  // Merges the normaliser's statistics over a data-parallel run's ranks (RunningMeanStd::merge).
+  void merge_statistics(GradSync* sync) {
+    if (config_.normalize_observations) normalizer_.merge(sync);
+  }
   void save(torch::serialize::OutputArchive& archive) const;
   void load(torch::serialize::InputArchive& archive);
 

@@ -205,6 +205,7 @@ class Sac final : public OffPolicyLearner {
       const torch::Tensor alpha_loss = sac_alpha_loss(log_alpha_, log_pi, target_entropy_);
       alpha_optimizer_.zero_grad();
       alpha_loss.backward();
+      average_gradients(sync(), log_alpha_.grad());
       alpha_optimizer_.step();
       record("alpha_loss", alpha_loss.item<double>());
     }
@@ -225,6 +226,7 @@ class Sac final : public OffPolicyLearner {
     const torch::Tensor qf_loss = 0.5 * q_losses.sum();
     critic_parameters_.zero_grad();
     qf_loss.backward();
+    average_gradients(sync(), critic_parameters_.tensor().grad());
     critic_optimizer_.step();
 
     // Actor: maximise min Q minus alpha log pi (the critics pass gradients to the actions only).
@@ -235,6 +237,7 @@ class Sac final : public OffPolicyLearner {
       actor_parameters_.zero_grad();
       actor_loss.backward();
     }
+    average_gradients(sync(), actor_parameters_.tensor().grad());
     actor_optimizer_.step();
 
     if (update % config_.target_update_interval == 0) {

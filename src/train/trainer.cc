@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "eval/figures.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
+#include "learn/grad_sync.h"
 #include "learn/hyperparams.h"
 #include "learn/intrinsic/reward.h"
 #include "learn/registry.h"
@@ -99,6 +102,48 @@ void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& d
   figures.draw(dir / "figures.json");
 }
 
+// Data-parallel: the name of the first value that is not the same on every rank ("" if none).
+std::string first_difference(GradSync& sync,
+                             const std::vector<std::pair<std::string, double>>& values) {
+  std::vector<double> extremes;
+  for (const auto& [name, value] : values) extremes.push_back(value);
+  for (const auto& [name, value] : values) extremes.push_back(-value);
+  sync.all_reduce_max(extremes);
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (extremes[i] != -extremes[values.size() + i]) return values[i].first;
+  }
+  return "";
+}
+
+// Data-parallel: every rank must run the same command, or the collectives would not pair up.
+void check_same_command(GradSync& sync, const std::vector<std::pair<std::string, double>>& values) {
+  const std::string differs = first_difference(sync, values);
+  if (!differs.empty()) {
+    throw UserError("the ranks run different commands (" + differs +
+                    " differs): start every rank with the same arguments");
+  }
+}
+
+// Data-parallel: the ranks' episodes and scores pooled into `stats`; returns whether any rank
+// was asked to stop (so that all stop at the same update).
+bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& score_count,
+                   bool stop) {
+  const bool none = stats.episodes == 0;
+  std::vector<double> sums = {static_cast<double>(stats.episodes),
+                              none ? 0 : stats.episodes * stats.episodic_return,
+                              none ? 0 : stats.episodes * stats.episodic_length,
+                              score_sum,
+                              static_cast<double>(score_count),
+                              stop ? 1.0 : 0.0};
+  sync.all_reduce_sum(sums);
+  stats.episodes = static_cast<int>(sums[0]);
+  stats.episodic_return = sums[0] > 0 ? sums[1] / sums[0] : std::nan("");
+  stats.episodic_length = sums[0] > 0 ? sums[2] / sums[0] : std::nan("");
+  score_sum = sums[3];
+  score_count = static_cast<int>(sums[4]);
+  return sums[5] > 0;
+}
+
 }  // namespace
 
 TrainResult train(const Config& config, const TrainOptions& options) {
@@ -129,10 +174,35 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     for (const auto& [name, value] : options.hyperparameters) hyperparameters[name] = value;
     resumed = load_run_state(latest, nullptr);
   }
-  const fs::path log_file = dir / "logs" / "training.jsonl";
-  const long kept_episodes = options.resume ? cut_training_log(log_file, resumed.episodes) : -1;
+  // Data-parallel: rank r seeds with seed + r; ranks above 0 log their envs in a folder of their
+  // own (continued as they are on resume: the checkpoint counts rank 0's episodes).
+  GradSync* sync = distributed(options.sync.get()) ? options.sync.get() : nullptr;
+  const int rank = sync ? sync->rank() : 0;
+  if (sync && algorithm != "ppo" && algorithm != "a2c" && algorithm != "sac") {
+    throw UserError("--distributed trains ppo, a2c or sac, not " + algorithm);
+  }
+  if (sync) {
+    std::string hp_text;
+    for (const auto& [name, value] : hyperparameters) hp_text += name + "=" + value + ";";
+    check_same_command(
+        *sync, {{"--envs", options.envs},
+                {"--steps", static_cast<double>(options.steps)},
+                {"--checkpoint-every", static_cast<double>(options.checkpoint_every)},
+                {"--algo", static_cast<double>(std::hash<std::string>{}(algorithm) % (1L << 40))},
+                {"--hp", static_cast<double>(std::hash<std::string>{}(hp_text) % (1L << 40))},
+                {"--resume", options.resume ? 1.0 : 0.0},
+                {"the checkpoint's step", static_cast<double>(resumed.steps)}});
+  }
+  Config env_config = config;
+  if (rank > 0) env_config.save_dir = (dir / "ranks" / std::to_string(rank)).string();
+  const fs::path log_file = fs::path(env_config.save_dir) / "logs" / "training.jsonl";
+  const long kept_episodes =
+      options.resume ? cut_training_log(log_file, rank == 0 ? resumed.episodes
+                                                            : std::numeric_limits<long>::max())
+                     : -1;
 
   // A curriculum wraps every env: the teacher sets its reset options before each reset.
+  const fs::path teacher_file = fs::path(env_config.save_dir) / "logs" / "teacher.jsonl";
   std::shared_ptr<teach::TeacherController> curriculum;
   EnvWrapper wrap;
   if (!options.teacher.empty() && options.task_space.empty())
@@ -140,9 +210,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (!options.task_space.empty()) {
     CurriculumSpec spec = load_task_space(options.task_space);
     if (!options.teacher.empty()) spec.teacher = options.teacher;
-    curriculum = make_controller(spec, options.seed);
-    if (options.resume && fs::exists(dir / "logs" / "teacher.jsonl")) {
-      for (const nlohmann::json& e : read_jsonl(dir / "logs" / "teacher.jsonl"))
+    curriculum = make_controller(spec, options.seed + rank);  // a teacher per rank
+    if (options.resume && fs::exists(teacher_file)) {
+      for (const nlohmann::json& e : read_jsonl(teacher_file))
         if (e.value("kind", "") == "train")
           curriculum->replay_train_episode(e["task"].get<teach::Task>(), e["return"], e["length"],
                                            e["success"], e["env_steps"]);
@@ -152,7 +222,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     };
   }
   std::optional<JsonlWriter> teacher_log;
-  if (curriculum) teacher_log.emplace(dir / "logs" / "teacher.jsonl", options.resume);
+  if (curriculum) teacher_log.emplace(teacher_file, options.resume);
   auto write_teacher_log = [&](bool dump) {
     if (!teacher_log) return;
     for (const teach::EpisodeRecord& e : curriculum->take_episodes())
@@ -170,8 +240,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     teacher_log->flush();
   };
   // A resumed run's first resets end no episode of this run's log.
-  TrainingVector training = make_babybench_training(config, options.envs, options.threads,
-                                                    options.seed, kept_episodes, wrap);
+  TrainingVector training = make_babybench_training(env_config, options.envs, options.threads,
+                                                    options.seed + rank, kept_episodes, wrap);
   std::unique_ptr<ThreadedVecEnv>& vec = training.vec;
   for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
     vec->env(i).set_reset_options({{"randomize_start", 1}});
@@ -188,7 +258,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // Behaviour score of the episodes that end, seen at the step that ends them.
   double score_sum = 0;
   int score_count = 0;
-  LearnerOptions lo{.seed = options.seed, .hyperparameters = hyperparameters};
+  LearnerOptions lo{.seed = options.seed + rank, .hyperparameters = hyperparameters};
+  lo.sync = options.sync;
   lo.update_threads = options.update_threads;
   lo.reward_hook = [&](const VecEnv& env, std::span<const double> actions,
                        std::span<double> rewards) {
@@ -219,6 +290,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     training.end_episodes();
     training_log->flush();
     const RunState run{.steps = learner->steps(), .episodes = training_log->episodes()};
+    if (rank > 0) return;  // rank 0 writes the run's checkpoints
     for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
   };
 
@@ -229,11 +301,13 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   for (size_t c = 0; c < std::size(kColumns); ++c)
     header += (c ? "," : "") + std::string(kColumns[c]);
   ProgressCut cut;
-  if (options.resume) cut = cut_progress(csv_file, header, resumed.steps);
+  if (options.resume && rank == 0) cut = cut_progress(csv_file, header, resumed.steps);
   if (!cut.kept_aside.empty())
     std::cerr << "progress.csv rows kept aside in " << cut.kept_aside.string() << "\n";
-  std::ofstream csv(csv_file, cut.append ? std::ios::app : std::ios::trunc);
-  if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
+  // Rank 0 writes progress.csv; the others' stream writes nowhere.
+  std::ofstream csv;
+  if (rank == 0) csv.open(csv_file, cut.append ? std::ios::app : std::ios::trunc);
+  if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
   if (!cut.append) csv << header << "\n";
   std::vector<std::vector<double>> rows = std::move(cut.rows);
   for (auto& row : rows) row.resize(std::size(kColumns), std::nan(""));
@@ -243,7 +317,15 @@ TrainResult train(const Config& config, const TrainOptions& options) {
       (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
   const long first_step = learner->steps();
   double last_score = std::nan("");
-  auto on_progress = [&](const TrainStats& s) {
+  // Stopping (Ctrl-C) is agreed by every rank of a data-parallel run.
+  bool stopped = false;
+  auto stopping = [&] { return sync ? stopped : options.stop && options.stop->load(); };
+  auto on_progress = [&](const TrainStats& local) {
+    TrainStats s = local;
+    if (sync) {
+      stopped =
+          pool_progress(*sync, s, score_sum, score_count, options.stop && options.stop->load());
+    }
     check_finite_losses(s, latest);
     write_teacher_log(false);
     if (reward) reward->update();
@@ -275,10 +357,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
     csv << "\n";
     csv.flush();
-    if (!csv) throw UserError("cannot write '" + csv_file.string() + "'");
+    if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
 
-    if (options.progress_bar) {
+    if (options.progress_bar && rank == 0) {
       const double done = static_cast<double>(s.steps) / options.steps;
       const double rate = (s.steps - first_step) / std::max(elapsed, 1e-9);
       const int width = 30;
@@ -291,10 +373,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
       std::fflush(stderr);
     }
     // Learning stops at each checkpoint (saved below) and continues in a new learn() call.
-    return s.steps < next_checkpoint && !(options.stop && options.stop->load());
+    return s.steps < next_checkpoint && !stopping();
   };
   // One learn() call per checkpoint interval.
-  while (learner->steps() < options.steps && !(options.stop && options.stop->load())) {
+  while (learner->steps() < options.steps && !stopping()) {
     const long before = learner->steps();
     learner->learn(options.steps, on_progress);
     if (learner->steps() >= next_checkpoint && learner->steps() < options.steps) {
@@ -305,7 +387,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     }
     if (learner->steps() == before) break;  // a learner that cannot advance
   }
-  if (options.progress_bar) std::fprintf(stderr, "\n");
+  if (options.progress_bar && rank == 0) std::fprintf(stderr, "\n");
 
   TrainResult result;
   result.steps = learner->steps();
@@ -319,6 +401,17 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   save_checkpoint(files);
   write_teacher_log(true);
   for (int i = 0; i < vec->num_envs(); ++i) vec->env(i).close();
+  result.parameter_hash = learner->parameter_hash();
+  // Data-parallel: every rank must end with the same networks.
+  const std::uint64_t hash = result.parameter_hash;
+  if (sync && !first_difference(*sync, {{"high", static_cast<double>(hash >> 32)},
+                                        {"low", static_cast<double>(hash & 0xffffffffULL)}})
+                   .empty()) {
+    throw UserError(
+        "the ranks' parameters differ after training (a learner broke the "
+        "data-parallel contract)");
+  }
+  if (rank > 0) return result;  // rank 0 draws, scores and evaluates the run
   if (!rows.empty()) plot_curves(rows, dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
   if (fs::exists(log_file))

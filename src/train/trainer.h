@@ -51,6 +51,10 @@ struct TrainOptions {
   std::string teacher;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
+  // A data-parallel run's ranks (docs/distributed.md); null or one rank: this process alone. Rank
+  // r seeds with seed + r; rank 0 writes progress.csv, checkpoints, plots and the evaluation;
+  // rank r > 0 logs its envs under <save_dir>/ranks/<r>/. PPO, A2C and SAC only.
+  std::shared_ptr<learn::GradSync> sync;
 };
 
 struct TrainResult {
@@ -61,6 +65,7 @@ struct TrainResult {
   std::optional<eval::EvaluationReport> evaluation;
   std::optional<eval::EvaluationReport> random_evaluation;
   std::filesystem::path checkpoint;
+  std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };
 
 TrainResult train(const Config& config, const TrainOptions& options);

@@ -1,0 +1,51 @@
+// What a learner needs from a data-parallel run, as a small interface so that learn/ does not
+// depend on how ranks talk (dist/ implements it over torch's c10d; train/dist_sync.h adapts it).
+// A learner given none (LearnerOptions::sync null) runs alone, unchanged.
+//
+// The data-parallel contract every learner keeps: rank 0's initial parameters are broadcast, every
+// gradient is averaged over the ranks before clipping and the optimiser step, and every decision
+// that changes the number of collectives (minibatch counts, early stops, when training starts)
+// is agreed on, so that every rank holds bitwise-identical parameters.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace cradle::learn {
+
+class GradSync {
+ public:
+  virtual ~GradSync() = default;
+  virtual int rank() const = 0;
+  virtual int world_size() const = 0;
+  // Element-wise sum (max: maximum) over the ranks, in place.
+  virtual void all_reduce_sum(std::span<float> values) = 0;
+  virtual void all_reduce_sum(std::span<double> values) = 0;
+  virtual void all_reduce_max(std::span<double> values) = 0;
+  // Rank 0's values to every rank.
+  virtual void broadcast(std::span<float> values) = 0;
+};
+
+// True when there is more than one rank.
+inline bool distributed(const GradSync* sync) { return sync != nullptr && sync->world_size() > 1; }
+inline int world_size(const GradSync* sync) { return sync != nullptr ? sync->world_size() : 1; }
+
+// Averages a float32 contiguous tensor (a packed gradient) over the ranks, in place.
+void average_gradients(GradSync* sync, const torch::Tensor& gradient);
+// Every float32 parameter and buffer of `module` set to rank 0's.
+void broadcast_module(GradSync* sync, torch::nn::Module& module);
+void broadcast_tensor(GradSync* sync, const torch::Tensor& tensor);
+// The maximum of a value over the ranks (e.g. a count that decides how many collectives follow).
+double agree_max(GradSync* sync, double value);
+// The mean of a value over the ranks (e.g. PPO's approximate KL for its early stop).
+double agree_mean(GradSync* sync, double value);
+// A rank's own random stream after every rank restored the same generator (resume): rank r > 0
+// draws a new seed from it mixed with r, rank 0 keeps it, so the ranks explore differently.
+void offset_generator(GradSync* sync, at::Generator& generator);
+// FNV-1a over the bytes of tensors (parameters), to compare ranks and runs.
+std::uint64_t tensor_hash(const std::vector<torch::Tensor>& tensors);
+
+}  // namespace cradle::learn

@@ -1,0 +1,185 @@
+// Data-parallel training end to end with real processes: `cradle launch` of 2 ranks on loopback
+// (PPO, A2C, SAC) ends with the same parameters on both; a killed rank stops the other with a
+// message naming it and the job resumes from its checkpoint; the same run across two network
+// namespaces joined by a veth pair, as two hosts would be (root only).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "fixture.h"
+#include "ranks.h"
+
+namespace cradle::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A quick self-touch config (no vision, 100-step episodes) writing to dir/run.
+std::string quick_config(const fs::path& dir) {
+  const fs::path file = dir / "config.yml";
+  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+                      << "\nvision_active: False\nmax_episode_steps: 100\nsave_logs_every: 1000\n";
+  return file.string();
+}
+
+// `cradle train` arguments for a tiny run of `algo`.
+std::string train_args(const fs::path& dir, const std::string& algo, long steps) {
+  std::string hp = " --hp n_steps=32 batch_size=16 n_epochs=2";
+  if (algo == "a2c") hp = " --hp n_steps=8";
+  if (algo == "sac") {
+    hp = " --hp learning_starts=16 batch_size=16 buffer_size=2000 report_every=16 pi_layers=32,32"
+         " qf_layers=32,32";
+  }
+  return "train --config " + quick_config(dir) + " --algo " + algo + " --envs 1 --threads 1" +
+         " --intrinsic body_part_novelty --steps " + std::to_string(steps) +
+         " --eval-episodes 0 --checkpoint-every 64 --seed 5 --dist-timeout 30" + hp;
+}
+
+// Every "rank R of N: parameter hash H" line's hash, by rank.
+std::map<int, std::string> hashes(const std::string& out) {
+  std::map<int, std::string> found;
+  const std::regex line("rank ([0-9]+) of [0-9]+: parameter hash ([0-9a-f]{16})");
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), line); it != std::sregex_iterator();
+       ++it) {
+    found[std::stoi((*it)[1])] = (*it)[2];
+  }
+  return found;
+}
+
+long last_step(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line, last;
+  while (std::getline(in, line)) last = line;
+  return last.empty() || !std::isdigit(last[0]) ? -1 : std::stol(last.substr(0, last.find(',')));
+}
+
+// A command line split at spaces (the arguments above hold none of their own).
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> out;
+  std::istringstream in(line);
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
+class Launch : public testing::TestWithParam<std::string> {};
+
+TEST_P(Launch, TwoRanksEndWithBitwiseIdenticalParameters) {
+  const std::string algo = GetParam();
+  const fs::path dir = fresh_dir("dist_launch_" + algo);
+  const RunResult r = run_cradle("launch --nproc 2 -- cradle " + train_args(dir, algo, 128));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::map<int, std::string> h = hashes(r.out);
+  ASSERT_EQ(h.size(), 2u) << r.out;
+  EXPECT_EQ(h.at(0), h.at(1));
+  // Rank 0 wrote the run's files, counting both ranks' steps; rank 1 logged its envs apart.
+  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), 128);
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
+  EXPECT_TRUE(fs::exists(dir / "run" / "ranks" / "1" / "logs"));
+  EXPECT_FALSE(fs::exists(dir / "run" / "ranks" / "1" / "checkpoints"));
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Learners, Launch, testing::Values("ppo", "a2c", "sac"));
+
+TEST(Launch, AFailingRankStopsTheOthersAndIsNamed) {
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult r = run_cradle(
+      "launch --nproc 3 -- sh -c 'if [ \"$RANK\" = 1 ]; then exit 3; fi; exec sleep 60'");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("rank 1 exited with status 3"), std::string::npos) << r.out;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30);
+}
+
+TEST(Launch, RefusesAMissingCommand) {
+  const RunResult r = run_cradle("launch --nproc 2");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("expected a command after --"), std::string::npos) << r.out;
+}
+
+TEST(Distributed, AKilledRankStopsTheOtherThenTheJobResumes) {
+  const fs::path dir = fresh_dir("dist_kill");
+  const int port = free_port();
+  const std::string args = train_args(dir, "ppo", 100000);
+  std::vector<Process> ranks;
+  for (int r = 0; r < 2; ++r) {
+    ranks.push_back(
+        spawn(words(std::string(CRADLE_BINARY) + " " + args + " --distributed --no-eval-video"),
+              {{"WORLD_SIZE", "2"},
+               {"RANK", std::to_string(r)},
+               {"MASTER_ADDR", "127.0.0.1"},
+               {"MASTER_PORT", std::to_string(port)}},
+              dir / ("rank" + std::to_string(r) + ".log")));
+  }
+  // Once a checkpoint exists, rank 1 dies.
+  const fs::path latest = dir / "run" / "checkpoints" / "latest.ckpt";
+  for (int i = 0; i < 1200 && !fs::exists(latest); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(fs::exists(latest)) << ranks[0].output();
+  ::kill(ranks[1].pid, SIGKILL);
+  EXPECT_EQ(wait_for(ranks[1]), 128 + SIGKILL);
+  EXPECT_EQ(wait_for(ranks[0], 40), 1) << ranks[0].output();
+  EXPECT_NE(ranks[0].output().find("rank 1 died"), std::string::npos) << ranks[0].output();
+
+  // The whole job resumes from rank 0's last checkpoint and ends identical on both ranks.
+  const long checkpoint = last_step(dir / "run" / "logs" / "progress.csv");
+  ASSERT_GE(checkpoint, 64);
+  const RunResult r = run_cradle("launch --nproc 2 -- cradle " +
+                                 train_args(dir, "ppo", checkpoint + 128) + " --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::map<int, std::string> h = hashes(r.out);
+  ASSERT_EQ(h.size(), 2u) << r.out;
+  EXPECT_EQ(h.at(0), h.at(1));
+  EXPECT_GE(last_step(dir / "run" / "logs" / "progress.csv"), checkpoint + 128);
+  fs::remove_all(dir);
+}
+
+// Two network namespaces joined by a veth pair (10.77.0.1 and 10.77.0.2), one rank in each.
+TEST(Distributed, TwoRanksAcrossNetworkNamespaces) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to create network namespaces";
+  const std::string ns = "cradle" + std::to_string(::getpid());
+  const std::string a = ns + "a", b = ns + "b";
+  const std::string setup = "ip netns add " + a + " && ip netns add " + b + " && ip link add " + a +
+                            "v type veth peer " + b + "v && ip link set " + a + "v netns " + a +
+                            " && ip link set " + b + "v netns " + b + " && ip -n " + a +
+                            " addr add 10.77.0.1/24 dev " + a + "v && ip -n " + b +
+                            " addr add 10.77.0.2/24 dev " + b + "v && ip -n " + a + " link set " +
+                            a + "v up && ip -n " + b + " link set " + b + "v up && ip -n " + a +
+                            " link set lo up && ip -n " + b + " link set lo up";
+  const RunResult made = run(setup + " 2>&1");
+  auto cleanup = [&] {
+    run("ip netns del " + a + " 2>/dev/null; ip netns del " + b + " 2>/dev/null");
+  };
+  if (made.status != 0) {
+    cleanup();
+    GTEST_SKIP() << "cannot create network namespaces here: " << made.out;
+  }
+  const fs::path dir = fresh_dir("dist_netns");
+  const std::string args = train_args(dir, "ppo", 128);
+  std::vector<Process> ranks;
+  for (int r = 0; r < 2; ++r) {
+    ranks.push_back(spawn({"/usr/sbin/ip", "netns", "exec", r == 0 ? a : b, "/bin/sh", "-c",
+                           std::string(CRADLE_BINARY) + " " + args + " --distributed"},
+                          {{"WORLD_SIZE", "2"},
+                           {"RANK", std::to_string(r)},
+                           {"MASTER_ADDR", "10.77.0.1"},
+                           {"MASTER_PORT", "29533"}},
+                          dir / ("rank" + std::to_string(r) + ".log")));
+  }
+  const int s0 = wait_for(ranks[0], 120), s1 = wait_for(ranks[1], 120);
+  cleanup();
+  ASSERT_EQ(s0, 0) << ranks[0].output();
+  ASSERT_EQ(s1, 0) << ranks[1].output();
+  const std::map<int, std::string> h0 = hashes(ranks[0].output()), h1 = hashes(ranks[1].output());
+  ASSERT_EQ(h0.size(), 1u);
+  ASSERT_EQ(h1.size(), 1u);
+  EXPECT_EQ(h0.at(0), h1.at(1));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cradle::test
