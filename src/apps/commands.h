@@ -15,5 +15,6 @@ void register_train(CLI::App& app);
 void register_illustrate(CLI::App& app);
 void register_tma(CLI::App& app);
 void register_sami(CLI::App& app);
+void register_soak(CLI::App& app);
 
 }  // namespace cradle::apps

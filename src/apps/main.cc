@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_illustrate(app);
   cradle::apps::register_tma(app);
   cradle::apps::register_sami(app);
+  cradle::apps::register_soak(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
