@@ -128,6 +128,7 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
 
   task_->declare(info_);
   contacts_.declare(info_);
+  overflow_slot_ = info_.declare(kOverflowKey, InfoType::kInt);
   sim_.restore(assets_->settled);
   observe();
 }
@@ -172,7 +173,7 @@ void BabyBenchEnv::end_episode() {
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log) {
   const Config& config = assets.config;
   const std::filesystem::path dir = config.save_dir;
-  scene::write_scene(assets.scene, dir);
+  scene::write_scene(assets.scene, dir / scene::kSceneDirName);
   std::error_code ec;
   std::filesystem::create_directories(dir / "videos", ec);
   return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.save_logs_every,
@@ -237,6 +238,11 @@ StepResult BabyBenchEnv::step(std::span<const double> action) {
   contacts_.update(sim_.data(), info_);
   ++steps_;
   result.truncated = steps_ >= assets_->config.max_episode_steps;
+  // A step whose physics overflowed MuJoCo's sizes is wrong: the episode ends there, counted.
+  if (const int n = sim_.overflows()) {
+    info_.add(overflow_slot_, n);
+    result.truncated = true;
+  }
   profile_.other += seconds(Clock::now() - task_start);
   ++profile_.steps;
   return result;
