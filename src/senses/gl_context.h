@@ -26,11 +26,11 @@ std::optional<GlBackend> gl_backend_from_name(std::string_view name);
 // UserError for any other value.
 std::optional<GlBackend> gl_backend_from_env();
 
-// The process's one GL lock. Mesa keeps per-process state under every context (OSMesa's and EGL's
-// single llvmpipe screen with its shared rasterizer, shader caches and drawable table) and MuJoCo
-// 2.2.2 reloads its process-wide GL function table in every mjr_makeContext, so two threads inside
-// GL at once, even in different contexts, can crash in libOSMesa (issue 19: two envs rendering on
-// two pool threads while contexts are built and freed). All GL work, context creation and
+// The process's one GL lock. Mesa keeps per-process state under every context (OSMesa draws all
+// contexts through one llvmpipe screen, a process singleton) and MuJoCo 2.2.2 reloads its
+// process-wide GL function table in every mjr_makeContext, so two threads inside GL at once, even
+// in different contexts, are the likely cause of the libOSMesa crashes of issue 19 (two envs
+// rendering on two pool threads while contexts are built and freed). All GL work, context creation and
 // destruction included, happens under this lock; GlScope takes it.
 std::mutex& gl_mutex();
 
