@@ -130,11 +130,9 @@ void register_soak(CLI::App& app) {
     }
     evaluate("after the vector");
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    const auto [rss, peak] = resident_mb();
     std::printf(
         "soak finished: %ld env steps on %d envs, %d evaluations, %.0f s, peak RSS %.0f MB\n",
-        steps, opts->envs, evaluations, seconds, peak);
-    (void)rss;
+        steps, opts->envs, evaluations, seconds, resident_mb().second);
   });
 }
 
