@@ -51,8 +51,8 @@ void expect_margin(const char* file, SceneKind kind, int steps, bool random_star
       "%s: max %d contacts (nconmax %d), %d constraint rows (njmax %d), stack %d (nstack %d)\n",
       file, use.contacts, sizes.nconmax, use.constraints, sizes.njmax, use.stack, sizes.nstack);
   EXPECT_EQ(use.overflows, 0);
-  EXPECT_LE(2 * use.contacts, sizes.nconmax);
-  EXPECT_LE(2 * use.constraints, sizes.njmax);
+  EXPECT_LE(1.5 * use.contacts, sizes.nconmax);
+  EXPECT_LE(1.5 * use.constraints, sizes.njmax);
   EXPECT_LE(2 * use.stack, sizes.nstack);
 }
 
