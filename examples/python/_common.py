@@ -58,7 +58,7 @@ def train_ppo(config, wrapper_class, reward_fn, train_for):
 
 def run_random_policy(description, default_config):
     """The reference's random baselines: a random policy for --train_for steps in training mode
-    (save_dir gets scene.xml and logs/training.jsonl), then the training score."""
+    (save_dir gets scene/scene.xml and logs/training.jsonl), then the training score."""
     args = parse_args(description, default_config)
     env = cradle.make_env(args.config, training=True)
     env.reset()

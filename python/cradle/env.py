@@ -145,7 +145,7 @@ class BabyBenchEnv(_EnvBase):
 
     Args:
       config: a dict of BabyBench keys, a YAML file path, or None for the documented defaults.
-      training: as babybench.utils.make_env: prepare save_dir (scene.xml, logs/, videos/) and
+      training: as babybench.utils.make_env: prepare save_dir (scene/, logs/, videos/) and
         record every episode in save_dir/logs/training.jsonl.
       render_mode: None or "rgb_array" (render() then returns a render_size^2 RGB image).
       seed: seed of the env's generator (random start actions) until reset(seed=...) reseeds it.

@@ -1,4 +1,5 @@
-// `cradle build-scene --config FILE [--out DIR]`: writes scene.xml and its textures.
+// `cradle build-scene --config FILE [--out DIR]`: writes scene.xml and its textures (into
+// <save_dir>/scene/, or into DIR).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -18,12 +19,15 @@ void register_build_scene(CLI::App& app) {
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "build-scene", "Write <save_dir>/scene.xml (or <out>/scene.xml) and its texture files");
+      "build-scene", "Write <save_dir>/scene/scene.xml (or <out>/scene.xml) and its texture files");
   cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
   cmd->add_option("--out", opts->out, "Output folder (default: the config's save_dir)");
   cmd->callback([opts] {
     const Config config = load_config(opts->config);
-    const std::filesystem::path dir = opts->out.empty() ? config.save_dir : opts->out;
+    // A results folder keeps its scene in scene/; --out is the folder itself.
+    const std::filesystem::path dir =
+        opts->out.empty() ? std::filesystem::path(config.save_dir) / scene::kSceneDirName
+                          : std::filesystem::path(opts->out);
     const scene::SceneFiles files = scene::compose_scene(config);
     // Compile before writing so a broken scene never lands on disk.
     const scene::ModelPtr model = scene::compile_scene(files);

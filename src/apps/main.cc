@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   cradle::apps::register_tma_campaign(*app.get_subcommand("tma"));
   cradle::apps::register_sami(app);
   cradle::apps::register_launch(app);
+  cradle::apps::register_soak(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,6 +1,7 @@
 // `cradle test-installation [--save-dir DIR]`: the reference's test_installation.py. Builds the
 // test_installation config (built in), steps it with random actions while filming the corner
-// camera, and writes <save_dir>/{scene.xml, logs/training.jsonl, videos/test_installation.mp4}.
+// camera, and writes <save_dir>/{scene/scene.xml, logs/training.jsonl,
+// videos/test_installation.mp4}.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -58,7 +59,7 @@ void register_test_installation(CLI::App& app) {
           1 + opts->steps, env->touch() ? env->touch()->sensor_count() : 0,
           config.vision_resolution, config.vision_resolution,
           env->observation_space().find("observation")->size());
-      std::printf("wrote %s/{scene.xml, logs/training.jsonl, videos/test_installation.mp4}\n",
+      std::printf("wrote %s/{scene/scene.xml, logs/training.jsonl, videos/test_installation.mp4}\n",
                   dir.c_str());
     } catch (const UserError&) {
       throw;

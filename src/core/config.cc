@@ -171,6 +171,7 @@ void for_each_field(C& c, Visit&& visit) {
   }
   visit("hand_regard_half_angle", c.hand_regard_half_angle, Range{0.0, 90.0, true});
   visit("hand_regard_occlusion", c.hand_regard_occlusion, kAny);
+  visit("mattress_friction_applies", c.mattress_friction_applies, kAny);
 }
 
 // First key written by the Cradle extensions; to_yaml puts a comment line before it.

@@ -54,6 +54,9 @@ struct Config {
   // Cradle extensions (not in the reference kit).
   double hand_regard_half_angle = 15.0;  // degrees, central field-of-view half-angle
   bool hand_regard_occlusion = false;    // ray-cast occlusion test for hand regard
+  // Crib: the mattress's low friction (0.1) applies to MIMo (contact priority). The reference's
+  // mattress has no priority, so MIMo meets his own friction (1-5) on it: false by default.
+  bool mattress_friction_applies = false;
 
   // Touch produces observations only when active and the sensor scale is positive.
   bool touch_enabled() const { return touch_active && touch_scale > 0.0; }

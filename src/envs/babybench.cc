@@ -98,6 +98,7 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
 
   task_->declare(info_);
   contacts_.declare(info_);
+  overflow_slot_ = info_.declare(kOverflowKey, InfoType::kInt);
   core_.sim().restore(assets_->settled);
   core_.observe();
 }
@@ -152,7 +153,7 @@ void BabyBenchEnv::end_episode() {
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log) {
   const Config& config = assets.config;
   const std::filesystem::path dir = config.save_dir;
-  scene::write_scene(assets.scene, dir);
+  scene::write_scene(assets.scene, dir / scene::kSceneDirName);
   std::error_code ec;
   std::filesystem::create_directories(dir / "videos", ec);
   return std::make_shared<TrainingLog>(dir / "logs" / "training.jsonl", config.save_logs_every,
@@ -212,6 +213,11 @@ StepResult BabyBenchEnv::step(std::span<const double> action) {
   contacts_.update(core_.data(), info_);
   ++steps_;
   result.truncated = steps_ >= assets_->config.max_episode_steps;
+  // A step whose physics overflowed MuJoCo's sizes is wrong: the episode ends there, counted.
+  if (const int n = core_.sim().overflows()) {
+    info_.add(overflow_slot_, n);
+    result.truncated = true;
+  }
   Profile& profile = core_.profile();
   profile.other += seconds(Clock::now() - task_start);
   ++profile.steps;

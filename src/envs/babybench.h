@@ -24,13 +24,14 @@
 namespace cradle::envs {
 
 // Builds an env the way babybench.utils.make_env does. training = true creates <save_dir> with
-// logs/ and videos/, writes scene.xml there and attaches a new training log.
+// logs/ and videos/, writes scene/scene.xml (and its textures) there and attaches a new training
+// log.
 std::unique_ptr<class BabyBenchEnv> make_env(const Config& config, bool training,
                                              std::uint64_t seed = 0);
 
 struct BabyBenchAssets {
   Config config;
-  scene::SceneFiles scene;  // what compiled `model`; written as scene.xml in training mode
+  scene::SceneFiles scene;  // what compiled `model`; written as scene/scene.xml in training mode
   scene::ModelPtr model;
   std::unique_ptr<senses::Touch> touch;  // null when touch is off
   ObservationLayout touch_layout;        // the skin's layout, published as the "touch" key's
@@ -44,7 +45,7 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config);
 std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
                                                    const std::filesystem::path& scene_file);
 
-// Prepares <save_dir> for a training run (scene.xml, logs/, videos/) and opens a new training log
+// Prepares <save_dir> for a training run (scene/, logs/, videos/) and opens a new training log
 // there, for one env or for every env of a vector. continue_log >= 0: continues the log, which
 // holds that many entries (a resumed run).
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log = -1);
@@ -60,6 +61,9 @@ class BabyBenchEnv final : public Env {
   static constexpr const char* kEyeLeftKey = senses::Eyes::kLeftKey;
   static constexpr const char* kEyeRightKey = senses::Eyes::kRightKey;
   static constexpr const char* kVestibularKey = MimoCore::kVestibularKey;
+  // Info key: MuJoCo size overflows (contacts, constraints, stack) in this episode; the step that
+  // overflows ends the episode (truncated). 0 in every normal episode.
+  static constexpr const char* kOverflowKey = "physics_overflow";
 
   static constexpr int kSettleSteps = 100;      // zero-action physics steps at construction
   static constexpr int kRandomResetSteps = 10;  // random actions applied at every reset
@@ -119,6 +123,7 @@ class BabyBenchEnv final : public Env {
   std::shared_ptr<TrainingLog> log_;
   int log_slot_ = -1;
   bool skip_record_ = false;  // the current episode is already recorded (or not this env's)
+  int overflow_slot_ = -1;    // info "physics_overflow": MuJoCo size overflows this episode
   Info info_;
   Rng rng_;
   std::vector<double> random_action_;

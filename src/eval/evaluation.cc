@@ -142,8 +142,10 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   const fs::path dir = config.save_dir;
   EvaluationReport report;
 
-  // The training scene when there is one (no re-build), else the config's.
-  const fs::path scene_file = dir / scene::kSceneFileName;
+  // The training scene when there is one (no re-build; scene/ since issue 19, the top level in
+  // older results folders), else the config's.
+  fs::path scene_file = dir / scene::kSceneDirName / scene::kSceneFileName;
+  if (!fs::exists(scene_file)) scene_file = dir / scene::kSceneFileName;
   auto assets =
       fs::exists(scene_file) ? envs::make_assets(config, scene_file) : envs::make_assets(config);
   envs::BabyBenchEnv env(assets, options.seed);

@@ -47,7 +47,18 @@ struct Composition {
   int offscreen = 480;  // offscreen buffer edge (px)
   std::array<double, 3> gravity{0, 0, -9.81};
   double density = 0;  // of the medium (kg/m^3), e.g. 1.2 for air
+  // MuJoCo 2.2.2's preallocated sizes: each mjData holds nconmax contacts, dense constraint
+  // arrays of njmax rows (njmax^2 doubles among them) and nstack doubles of stack.
+  int nconmax = 1000, njmax = 5000, nstack = 2000000;
 };
+
+// The sizes of a BabyBench scene: the measured maxima (random actions from random starts) with a
+// safety margin, so an env takes a few MB instead of the reference's ~300 (docs/
+// babybench-physics.md). An overflow ends the episode cleanly (sim::Sim::overflows()).
+struct SceneSizes {
+  int nconmax, njmax, nstack;
+};
+SceneSizes scene_sizes(SceneKind kind);
 // The scene text and texture files of a composition.
 SceneFiles compose(const Composition& composition);
 
@@ -62,5 +73,8 @@ void write_scene(const SceneFiles& scene, const std::filesystem::path& dir);
 ModelPtr load_scene(const std::filesystem::path& file);
 
 inline constexpr const char* kSceneFileName = "scene.xml";
+// A results folder keeps its scene (scene.xml and the texture PNGs) in this subfolder, so that its
+// top level reads logs, checkpoints, plots, videos and evaluation.
+inline constexpr const char* kSceneDirName = "scene";
 
 }  // namespace cradle::scene

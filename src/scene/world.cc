@@ -58,7 +58,7 @@ std::string rail_body(std::string_view name, double x, double y, double yaw, dou
          vec(0, 0, yaw) + "\">\n" + rail_geoms(half) + "</body>\n";
 }
 
-WorldFragments crib_world() {
+WorldFragments crib_world(bool mattress_friction_applies) {
   WorldFragments crib;
   // Light-wood checker with dark edge marks; plain off-white mattress.
   crib.assets =
@@ -90,15 +90,18 @@ WorldFragments crib_world() {
               "\" material=\"matcrib\"/>\n";
     }
   }
-  // Low-friction mattress. priority="1" makes MuJoCo take the mattress's friction (and solver
-  // parameters, condim) for every contact with it instead of the element-wise maximum, so the
-  // reduced friction really applies to MIMo. solref/solimp are the values the reference's
-  // equal-priority mix produces against MIMo's skin geoms (solref .005 1, solimp .95 .99 .001 .5 1
-  // averaged with the geom defaults), so contact stiffness matches the reference.
+  // Mattress with the reference's friction 0.1. As in the reference it has no contact priority
+  // and MuJoCo's default solver parameters: against MIMo, MuJoCo takes the element-wise maximum
+  // friction (MIMo's 1-5) and averages solref/solimp. Opt-in (mattress_friction_applies):
+  // priority="1" makes the mattress's friction apply to MIMo, with solref/solimp set to the
+  // average the reference's mix gives against MIMo's skin (solref .005 1, solimp .95 .99 .001 .5
+  // 1 with the defaults .02 1, .9 .95 .001 .5 2), so only the friction differs.
   body +=
       "<geom name=\"mattress\" type=\"box\" size=\"0.52 0.4 0.075\" pos=\"-0.05 0 0.025\" "
-      "material=\"matmattress\" friction=\"0.1 0.0005 0.00001\" priority=\"1\" "
-      "solref=\"0.0125 1\" solimp=\"0.925 0.97 0.001 0.5 1.5\"/>\n";
+      "material=\"matmattress\" friction=\"0.1 0.0005 0.00001\"";
+  body += mattress_friction_applies
+              ? " priority=\"1\" solref=\"0.0125 1\" solimp=\"0.925 0.97 0.001 0.5 1.5\"/>\n"
+              : "/>\n";
   body += "</body>\n</body>\n";
   crib.worldbody = body;
   // MIMo's lower trunk is welded to the world at its reference pose.
@@ -246,10 +249,10 @@ std::string base_visual() {
          "<headlight active=\"0\"/>\n";
 }
 
-WorldFragments scene_world(SceneKind kind) {
+WorldFragments scene_world(SceneKind kind, bool mattress_friction_applies) {
   switch (kind) {
     case SceneKind::kCrib:
-      return crib_world();
+      return crib_world(mattress_friction_applies);
     case SceneKind::kCubes:
       return cubes_world();
     case SceneKind::kBase:

@@ -27,8 +27,9 @@ struct WorldFragments {
 WorldFragments base_world();
 // Children of <visual> for the base room: map force/fog/shadow clip, no headlight, no shadows.
 std::string base_visual();
-// What the scene adds to the base room (empty for kBase).
-WorldFragments scene_world(SceneKind kind);
+// What the scene adds to the base room (empty for kBase). mattress_friction_applies: the crib
+// mattress's friction 0.1 overrides MIMo's (Cradle's opt-in; the reference mixes by maximum).
+WorldFragments scene_world(SceneKind kind, bool mattress_friction_applies = false);
 
 // Pose of the body "mimo_location" (which carries MIMo's free joint) in each scene.
 struct Placement {

@@ -115,6 +115,7 @@ class OsmesaContext final : public GlContext {
   }
 
   ~OsmesaContext() override {
+    const std::lock_guard lock(gl_mutex());
     if (is_current()) release();
     destroy_(ctx_);
   }
@@ -199,6 +200,7 @@ class EglContext final : public GlContext {
   // The display stays initialised: EGL displays are per-process and shared with other contexts,
   // and eglTerminate would invalidate theirs.
   ~EglContext() override {
+    const std::lock_guard lock(gl_mutex());
     if (is_current()) release();
     destroy_context_(display_, ctx_);
   }
@@ -283,6 +285,12 @@ class EglContext final : public GlContext {
 
 }  // namespace
 
+std::mutex& gl_mutex() {
+  // The one process-wide object here: it stands for the process-wide state inside Mesa.
+  static std::mutex mutex;
+  return mutex;
+}
+
 std::string_view gl_backend_name(GlBackend backend) {
   return backend == GlBackend::kEgl ? "egl" : "osmesa";
 }
@@ -320,6 +328,7 @@ std::unique_ptr<GlContext> GlContext::create(int max_width, int max_height) {
 }
 
 std::unique_ptr<GlContext> GlContext::create(GlBackend backend, int max_width, int max_height) {
+  const std::lock_guard lock(gl_mutex());
   require_platform(backend);
   if (backend == GlBackend::kEgl) return std::make_unique<EglContext>();
   return std::make_unique<OsmesaContext>(max_width, max_height);

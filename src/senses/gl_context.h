@@ -9,6 +9,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -25,8 +26,18 @@ std::optional<GlBackend> gl_backend_from_name(std::string_view name);
 // UserError for any other value.
 std::optional<GlBackend> gl_backend_from_env();
 
+// The process's one GL lock. Mesa keeps per-process state under every context (OSMesa draws all
+// contexts through one llvmpipe screen, a process singleton) and MuJoCo 2.2.2 reloads its
+// process-wide GL function table in every mjr_makeContext, so two threads inside GL at once, even
+// in different contexts, are the likely cause of the libOSMesa crashes of issue 19 (two envs
+// rendering on two pool threads while contexts are built and freed). All GL work, context creation and
+// destruction included, happens under this lock; GlScope takes it.
+std::mutex& gl_mutex();
+
 // One GL context with a compatibility profile (MuJoCo's fixed-function renderer), owned by this
 // object. It is current on at most one thread at a time; make_current() binds it to the caller.
+// create() and the destructor take gl_mutex() themselves; make_current() and release() must be
+// called under it (use GlScope).
 class GlContext {
  public:
   // Backend from CRADLE_GL; unset: OSMesa, or EGL where libOSMesa is missing. max_width and
@@ -54,6 +65,20 @@ class GlContext {
 
  private:
   std::string description_;
+};
+
+// Holds gl_mutex() and keeps a context bound to the calling thread for one scope, unbinding it on
+// exit so that any thread may use it next.
+class GlScope {
+ public:
+  explicit GlScope(GlContext& gl) : lock_(gl_mutex()), gl_(gl) { gl_.make_current(); }
+  ~GlScope() { gl_.release(); }
+  GlScope(const GlScope&) = delete;
+  GlScope& operator=(const GlScope&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
+  GlContext& gl_;
 };
 
 }  // namespace cradle::senses

@@ -82,19 +82,6 @@ class Frustum {
 // Margin on bounding radii against float rounding in Frustum::outside.
 constexpr float kCullMargin = 1e-3f;
 
-// Binds a GL context for one scope and unbinds it on exit, so that any thread may render next
-// (binding costs ~0.1 us on OSMesa, ~1 us on EGL).
-class Bound {
- public:
-  explicit Bound(GlContext& gl) : gl_(gl) { gl_.make_current(); }
-  ~Bound() { gl_.release(); }
-  Bound(const Bound&) = delete;
-  Bound& operator=(const Bound&) = delete;
-
- private:
-  GlContext& gl_;
-};
-
 }  // namespace
 
 RenderQuality RenderQuality::fast(int resolution) {
@@ -136,7 +123,7 @@ CameraRenderer::CameraRenderer(const mjModel* m, int max_width, int max_height,
     header.geom_size = sizes.data();
   }
 
-  const Bound bound(*gl_);
+  const GlScope bound(*gl_);
   mjv_defaultOption(&option_);
   mjv_defaultCamera(&camera_);
   camera_.type = mjCAMERA_FIXED;
@@ -155,7 +142,7 @@ CameraRenderer::CameraRenderer(const mjModel* m, int max_width, int max_height,
 CameraRenderer::~CameraRenderer() {
   // GL objects die with the context anyway; freeing them needs the context bound here.
   try {
-    const Bound bound(*gl_);
+    const GlScope bound(*gl_);
     mjr_freeContext(&con_);
   } catch (const UserError&) {
   }
@@ -234,7 +221,7 @@ void CameraRenderer::render(const mjModel* m, mjData* d, int camera_id, int w, i
   if (w < 1 || h < 1 || w > max_width_ || h > max_height_) {
     throw std::invalid_argument("CameraRenderer: image size beyond the renderer's maximum");
   }
-  const Bound bound(*gl_);
+  const GlScope bound(*gl_);
   update(m, d, camera_id);
   draw(m, d, camera_id, mjrRect{0, 0, w, h});
   const std::array<std::span<std::uint8_t>, 1> outs = {out};
@@ -249,7 +236,7 @@ void CameraRenderer::render_pair(const mjModel* m, mjData* d, int camera_a, int 
   if (w < 1 || h < 1 || 2 * w > max_width_ || h > max_height_) {
     throw std::invalid_argument("CameraRenderer: image pair beyond the renderer's maximum");
   }
-  const Bound bound(*gl_);
+  const GlScope bound(*gl_);
   // One scene update serves both views; only the camera differs.
   update(m, d, camera_a);
   draw(m, d, camera_a, mjrRect{0, 0, w, h});

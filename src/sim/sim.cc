@@ -1,11 +1,28 @@
 #include "sim/sim.h"
 
 #include <algorithm>
+#include <cctype>
+#include <string>
 
 #include "core/error.h"
 #include "sim/mujoco_handlers.h"
 
 namespace cradle::sim {
+namespace {
+
+// Overflow warnings MuJoCo has counted in d since its last reset.
+int overflow_warnings(const mjData* d) {
+  return d->warning[mjWARN_CONTACTFULL].number + d->warning[mjWARN_CNSTRFULL].number;
+}
+
+// MuJoCo 2.2.2 reports a stack overflow as an error ("... stack ...").
+bool is_stack_overflow(const UserError& e) {
+  std::string text = e.what();
+  for (char& ch : text) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return text.find("stack") != std::string::npos;
+}
+
+}  // namespace
 
 Sim::Sim(const mjModel* m, ActuationModel kind, int frame_skip)
     : m_(m),
@@ -17,10 +34,20 @@ Sim::Sim(const mjModel* m, ActuationModel kind, int frame_skip)
 }
 
 void Sim::step(std::span<const double> action) {
-  actuation_->apply(action, d_.get());
-  for (int i = 0; i < frame_skip_; ++i) {
-    actuation_->substep(d_.get());
-    mj_step(m_, d_.get());
+  mjData* d = d_.get();
+  overflows_ = 0;
+  actuation_->apply(action, d);
+  for (int i = 0; i < frame_skip_ && overflows_ == 0; ++i) {
+    actuation_->substep(d);
+    const int before = overflow_warnings(d);
+    try {
+      mj_step(m_, d);
+    } catch (const UserError& e) {
+      if (!is_stack_overflow(e)) throw;
+      d->pstack = 0;  // the aborted step's stack frames
+      ++overflows_;
+    }
+    overflows_ += overflow_warnings(d) - before;
   }
 }
 

@@ -37,8 +37,13 @@ class Sim {
   int frame_skip() const { return frame_skip_; }
   double dt() const { return frame_skip_ * m_->opt.timestep; }
 
-  // One env step: the action once, then frame_skip physics substeps.
+  // One env step: the action once, then frame_skip physics substeps. A substep that overflows
+  // MuJoCo's preallocated sizes (contacts beyond nconmax, constraint rows beyond njmax: MuJoCo
+  // drops them and warns; the stack: MuJoCo errors mid-step) ends the step early, its physics
+  // wrong, and is counted in overflows() for the caller to end the episode.
   void step(std::span<const double> action);
+  // Overflows in the last step() (0 when its physics is right).
+  int overflows() const { return overflows_; }
   // mj_resetData and a zero action.
   void reset();
 
@@ -51,6 +56,7 @@ class Sim {
   DataPtr d_;
   std::unique_ptr<Actuation> actuation_;
   int frame_skip_;
+  int overflows_ = 0;
 };
 
 }  // namespace cradle::sim

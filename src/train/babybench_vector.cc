@@ -12,11 +12,13 @@
 namespace cradle::train {
 namespace {
 
-// Refuses a vector whose envs' MuJoCo data (stack and buffer, sized by the model's njmax and
-// nconmax) and eye images need more than 80 % of the physical memory: it would be killed or swap.
+// Refuses a vector whose envs' MuJoCo data (stack, buffer and the dense constraint arrays, about
+// 12 bytes per njmax^2 as measured on MuJoCo 2.2.2) and eye images need more than 80 % of the
+// physical memory: it would be killed or swap.
 void check_env_memory(const envs::BabyBenchAssets& assets, int num_envs) {
   const mjModel* m = assets.model.get();
-  double per_env = static_cast<double>(m->nstack) * sizeof(mjtNum) + m->nbuffer;
+  double per_env = static_cast<double>(m->nstack) * sizeof(mjtNum) + m->nbuffer +
+                   12.0 * static_cast<double>(m->njmax) * m->njmax;
   if (assets.config.vision_active) {
     per_env += 2.0 * 4 * assets.config.vision_resolution * assets.config.vision_resolution * 4;
   }

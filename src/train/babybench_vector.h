@@ -13,7 +13,8 @@
 namespace cradle::train {
 
 // BabyBench envs sharing one set of assets (one compiled model; each env still holds its own
-// mjData, about 300 MB with the reference scenes' njmax = 5000). training = true prepares
+// mjData: 5-34 MB with the scene sizes of scene::scene_sizes, 300 MB at the reference's
+// njmax = 5000). training = true prepares
 // <save_dir> as envs::make_env does and attaches one shared training log to every env, written in
 // env order; continue_log >= 0 continues the log that holds that many entries (resume). Refuses
 // (UserError) a vector that would not fit in memory.

@@ -125,7 +125,7 @@ TEST(Cli, TestInstallationWritesSceneLogAndVideo) {
   const CliResult r = run_cradle("test-installation --save-dir " + (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("passed"), std::string::npos);
-  EXPECT_TRUE(fs::exists(dir / "out" / "scene.xml"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "scene" / "scene.xml"));
   EXPECT_TRUE(fs::exists(dir / "out" / "logs" / "training.jsonl"));
   const nlohmann::json v = probe(dir / "out" / "videos" / "test_installation.mp4");
   EXPECT_EQ(v["codec_name"], "h264");

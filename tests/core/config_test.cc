@@ -197,6 +197,7 @@ TEST(ConfigDefaults, DefaultConfigHasDocumentedDefaults) {
   EXPECT_EQ(c.lock_groups, GroupFlags::all(false));
   EXPECT_EQ(c.hand_regard_half_angle, 15.0);
   EXPECT_FALSE(c.hand_regard_occlusion);
+  EXPECT_FALSE(c.mattress_friction_applies);  // the reference's crib dynamics
 }
 
 TEST(ConfigDefaults, EmptyInputsGiveDefaults) {
@@ -231,6 +232,14 @@ TEST(ConfigValues, BooleanSpellings) {
   }
   for (const char* text : {"False", "false", "FALSE", "no", "OFF", "!!bool false"}) {
     EXPECT_FALSE(parse_config(std::string("vision_active: ") + text, "x").vision_active) << text;
+  }
+  EXPECT_TRUE(parse_config("mattress_friction_applies: True", "x").mattress_friction_applies);
+  try {
+    parse_config("mattress_friction_applies: 0.1", "x.yml");
+    ADD_FAILURE() << "a number for a boolean key was accepted";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("mattress_friction_applies"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -292,6 +301,7 @@ TEST(ConfigNames, KeysAreDocKeysThenExtensions) {
   std::vector<std::string> want = kDocKeys;
   want.push_back("hand_regard_half_angle");
   want.push_back("hand_regard_occlusion");
+  want.push_back("mattress_friction_applies");
   const auto keys = config_keys();
   EXPECT_EQ(std::vector<std::string>(keys.begin(), keys.end()), want);
 }
@@ -512,6 +522,7 @@ TEST(ConfigRoundTrip, EveryFieldChanged) {
   c.lock_groups = all_but({Group::kArms});
   c.hand_regard_half_angle = 22.5;
   c.hand_regard_occlusion = true;
+  c.mattress_friction_applies = true;
   const Config back = parse_config(to_yaml(c), "round_trip");
   EXPECT_EQ(back, c);
   EXPECT_EQ(back.save_dir, c.save_dir);

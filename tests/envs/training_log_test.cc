@@ -26,7 +26,13 @@ TEST(TrainingLog, EpisodesAreAppendedAndReloaded) {
   config.save_logs_every = 2;
   {
     auto env = make_env(config, /*training=*/true, 3);
-    EXPECT_TRUE(fs::exists(dir / "scene.xml"));
+    // The scene and its textures in scene/, nothing of it at the top.
+    EXPECT_TRUE(fs::exists(dir / "scene" / "scene.xml"));
+    EXPECT_TRUE(fs::exists(dir / "scene" / "tex_head_default_right.png"));
+    EXPECT_FALSE(fs::exists(dir / "scene.xml"));
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      EXPECT_NE(entry.path().extension(), ".png") << entry.path();
+    }
     env->reset(3);
     std::vector<double> action(env->action_space().size(), 0.2);
     for (int t = 0; t < 75; ++t) {

@@ -239,7 +239,7 @@ TEST(ThreadedVecEnv, TrainingWritesOneSharedLog) {
   config.save_dir = dir.string();
   {
     const auto vec = train::make_babybench_vec_env(config, 3, 2, /*training=*/true, 9);
-    EXPECT_TRUE(fs::exists(dir / "scene.xml"));
+    EXPECT_TRUE(fs::exists(dir / "scene" / "scene.xml"));
     EXPECT_TRUE(fs::is_directory(dir / "videos"));
     vec->reset(9);
     std::vector<double> actions(3 * vec->action_space().size(), 0.1);

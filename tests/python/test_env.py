@@ -105,7 +105,7 @@ def test_make_ids_and_overrides(tmp_path):
     env = cradle.make("BabyBench-SelfTouch", touch_active=False, save_dir=str(tmp_path))
     assert "touch" not in env.observation_space.spaces
     assert env.config["behavior"] == "self_touch" and env.config["scene"] == "crib"
-    assert not (tmp_path / "scene.xml").exists()  # make() does not train by default
+    assert not (tmp_path / "scene").exists()  # make() does not train by default
     default = cradle.make("BabyBench", vision_active=False)
     assert default.action_space.shape == (44,)  # every actuator group of MIMo v1
     with pytest.raises(ValueError, match="unknown env id"):

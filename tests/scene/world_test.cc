@@ -97,10 +97,11 @@ using TestData = std::unique_ptr<mjData, FreeData>;
 
 // Writes and compiles the whole test scene: base room + scene fragment + stand-in infant +
 // `extra` bodies in the worldbody.
-TestModel build_scene(SceneKind kind, const std::string& extra = "") {
+TestModel build_scene(SceneKind kind, const std::string& extra = "",
+                      bool mattress_friction_applies = false) {
   const fs::path dir = make_temp_dir();
   const WorldFragments base = base_world();
-  const WorldFragments scene = scene_world(kind);
+  const WorldFragments scene = scene_world(kind, mattress_friction_applies);
   const std::string xml =
       "<mujoco model=\"world_test\">\n"
       "<compiler angle=\"degree\" inertiafromgeom=\"true\"/>\n"
@@ -122,6 +123,23 @@ int id_of(const mjModel* m, mjtObj type, const char* name) {
   const int id = mj_name2id(m, type, name);
   EXPECT_GE(id, 0) << name;
   return id;
+}
+
+// The one contact between the geoms "probe" and "mattress" (a zeroed contact when there is none).
+mjContact probe_contact(const mjModel* m, const mjData* d) {
+  const int ball = id_of(m, mjOBJ_GEOM, "probe");
+  const int mattress = id_of(m, mjOBJ_GEOM, "mattress");
+  mjContact found{};
+  int n = 0;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    if ((c.geom1 == ball && c.geom2 == mattress) || (c.geom1 == mattress && c.geom2 == ball)) {
+      found = c;
+      ++n;
+    }
+  }
+  EXPECT_EQ(n, 1);
+  return found;
 }
 
 TEST(BaseWorld, CamerasLightsFloorAndTextures) {
@@ -182,7 +200,7 @@ TEST(BaseWorld, CamerasLightsFloorAndTextures) {
   EXPECT_GE(id_of(m.get(), mjOBJ_TEXTURE, "texrug"), 0);
 }
 
-TEST(CribWorld, MattressWeldAndLowFriction) {
+TEST(CribWorld, MattressWeldAndReferenceFriction) {
   // A probe ball with MIMo's skin contact parameters, dropped onto the mattress.
   const std::string probe =
       "<body name=\"probe\" pos=\"0.2 0 0.3\"><freejoint/><geom name=\"probe\" type=\"sphere\" "
@@ -197,7 +215,7 @@ TEST(CribWorld, MattressWeldAndLowFriction) {
   EXPECT_NEAR(d->geom_xpos[3 * mattress + 2] + m->geom_size[3 * mattress + 2], 0.25, 1e-12);
   EXPECT_NEAR(d->geom_xpos[3 * mattress], -0.05, 1e-12);
   EXPECT_NEAR(m->geom_friction[3 * mattress], 0.1, 1e-12);
-  EXPECT_EQ(m->geom_priority[mattress], 1);
+  EXPECT_EQ(m->geom_priority[mattress], 0);  // as the reference's
   for (const char* name :
        {"crib", "crib_feet", "crib_head", "crib_left", "crib_right", "crib_base"}) {
     const int body = id_of(m.get(), mjOBJ_BODY, name);
@@ -219,27 +237,38 @@ TEST(CribWorld, MattressWeldAndLowFriction) {
   const std::array<double, 3> start{d->xpos[3 * lower], d->xpos[3 * lower + 1],
                                     d->xpos[3 * lower + 2]};
 
-  // After the probe lands, its contact with the mattress uses the mattress's friction.
+  // After the probe lands, its contact with the mattress takes the larger friction (the probe's
+  // default 1), as in the reference; solver parameters are the equal-priority mix.
   for (int i = 0; i < 100; ++i) mj_step(m.get(), d.get());
-  const int ball = id_of(m.get(), mjOBJ_GEOM, "probe");
-  int found = 0;
-  for (int i = 0; i < d->ncon; ++i) {
-    const mjContact& c = d->contact[i];
-    if ((c.geom1 == ball && c.geom2 == mattress) || (c.geom1 == mattress && c.geom2 == ball)) {
-      ++found;
-      EXPECT_NEAR(c.friction[0], 0.1, 1e-12);
-      EXPECT_NEAR(c.friction[2], 0.0005, 1e-12);
-      EXPECT_NEAR(c.solref[0], 0.0125, 1e-12);
-    }
-  }
-  EXPECT_EQ(found, 1);
+  const mjContact c = probe_contact(m.get(), d.get());
+  EXPECT_NEAR(c.friction[0], 1, 1e-12);
+  EXPECT_NEAR(c.friction[2], 0.005, 1e-12);
+  EXPECT_NEAR(c.solref[0], 0.0125, 1e-12);
   EXPECT_NEAR(d->xpos[3 * id_of(m.get(), mjOBJ_BODY, "probe") + 2], 0.27, 2e-3);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(d->xpos[3 * lower + k], start[k], 1e-3);
 }
 
+TEST(CribWorld, OptInMattressFrictionAppliesToMimo) {
+  // mattress_friction_applies: contact priority makes the mattress's 0.1 apply; same stiffness.
+  const std::string probe =
+      "<body name=\"probe\" pos=\"0.2 0 0.3\"><freejoint/><geom name=\"probe\" type=\"sphere\" "
+      "size=\"0.02\" solref=\"0.005 1\" solimp=\"0.95 0.99 0.001 0.5 1\"/></body>\n";
+  TestModel m = build_scene(SceneKind::kCrib, probe, /*mattress_friction_applies=*/true);
+  ASSERT_NE(m, nullptr);
+  TestData d(mj_makeData(m.get()));
+  EXPECT_EQ(m->geom_priority[id_of(m.get(), mjOBJ_GEOM, "mattress")], 1);
+  for (int i = 0; i < 100; ++i) mj_step(m.get(), d.get());
+  const mjContact c = probe_contact(m.get(), d.get());
+  EXPECT_NEAR(c.friction[0], 0.1, 1e-12);
+  EXPECT_NEAR(c.friction[2], 0.0005, 1e-12);
+  EXPECT_NEAR(c.solref[0], 0.0125, 1e-12);
+  EXPECT_NEAR(d->xpos[3 * id_of(m.get(), mjOBJ_BODY, "probe") + 2], 0.27, 2e-3);
+}
+
 TEST(CribWorld, MattressSolverParamsMatchReferenceMix) {
-  // Without priorities MuJoCo 2.2.2 averages solref/solimp; the mattress declares exactly what a
-  // default geom and a skin geom average to, so contact stiffness is as in the reference.
+  // Without priorities MuJoCo 2.2.2 averages solref/solimp; the opt-in priority mattress declares
+  // exactly what a default geom and a skin geom average to, so contact stiffness stays the
+  // reference's.
   const char* xml =
       "<mujoco><worldbody><geom name=\"board\" type=\"box\" size=\"1 1 0.1\"/>"
       "<body pos=\"0 0 0.115\"><freejoint/><geom name=\"skin\" type=\"sphere\" size=\"0.02\" "
@@ -254,7 +283,7 @@ TEST(CribWorld, MattressSolverParamsMatchReferenceMix) {
   mj_forward(mix.get(), d.get());
   ASSERT_EQ(d->ncon, 1);
 
-  TestModel crib = build_scene(SceneKind::kCrib);
+  TestModel crib = build_scene(SceneKind::kCrib, "", /*mattress_friction_applies=*/true);
   ASSERT_NE(crib, nullptr);
   const int mattress = id_of(crib.get(), mjOBJ_GEOM, "mattress");
   for (int k = 0; k < mjNREF; ++k) {

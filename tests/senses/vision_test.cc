@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -201,6 +202,45 @@ TEST(Vision, EyesOnSeveralThreads) {
   worker.join();
   std::thread([&] { check(a); }).join();
   check(a);
+}
+
+// What crashed hand-regard training in libOSMesa (issue 19): envs rendering on pool threads while
+// another thread builds and frees contexts (the evaluation env, its video renderer). Every image
+// must stay exact and nothing may crash.
+TEST(Vision, ContextsComeAndGoWhileOtherThreadsRender) {
+  auto model = boxes_model();
+  const mjModel* m = model.get();
+  std::atomic<bool> stop{false};
+  std::atomic<int> renders{0}, wrong{0};
+  auto render_loop = [&] {
+    Eyes eyes(m, 64);
+    mjData* d = mj_makeData(m);
+    mj_forward(m, d);
+    Image left(64 * 64 * 3), right(left.size());
+    while (!stop.load()) {
+      eyes.render(m, d, left, right);
+      wrong += !red(pixel(left, 64, 32, 32)) || !green(pixel(right, 64, 6, 32));
+      ++renders;
+    }
+    mj_deleteData(d);
+  };
+  std::thread a(render_loop), b(render_loop);
+  // Contexts of two sizes built, used and freed here meanwhile.
+  mjData* d = mj_makeData(m);
+  mj_forward(m, d);
+  Image image(96 * 96 * 3);
+  for (int i = 0; i < 2; ++i) {
+    CameraRenderer video(m, 96, 96, RenderQuality::model());
+    video.render(m, d, 0, 96, 96, image);
+    EXPECT_TRUE(red(pixel(image, 96, 48, 48)));
+    Eyes eyes(m, 64);
+  }
+  stop = true;
+  a.join();
+  b.join();
+  mj_deleteData(d);
+  EXPECT_GT(renders.load(), 8);
+  EXPECT_EQ(wrong.load(), 0);
 }
 
 TEST(Vision, UnknownBackendIsAOneLineUserError) {

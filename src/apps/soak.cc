@@ -1,0 +1,139 @@
+// `cradle soak --config FILE [--steps N] [--envs N] [--threads T] [--eval-every N] ...`: the
+// long-running vision soak (issue 19, item 0). Random actions drive a vector of envs on a thread
+// pool for N env steps; every --eval-every steps an evaluation env with its video renderer is
+// built, run and destroyed on the main thread while the vector's contexts live (the train ->
+// evaluation transition that crashed), and the run ends with an evaluation with video. It prints
+// progress, steps/s and the resident memory, and exits 0 only when everything finished.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/cli_checks.h"
+#include "apps/commands.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/rng.h"
+#include "eval/evaluation.h"
+#include "train/babybench_vector.h"
+
+namespace cradle::apps {
+namespace {
+
+// Resident and peak resident memory of this process, MB (/proc/self/status).
+std::pair<double, double> resident_mb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  double rss = 0, peak = 0;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) rss = std::stod(line.substr(6)) / 1024;
+    if (line.rfind("VmHWM:", 0) == 0) peak = std::stod(line.substr(6)) / 1024;
+  }
+  return {rss, peak};
+}
+
+}  // namespace
+
+void register_soak(CLI::App& app) {
+  struct Options {
+    std::string config;
+    std::string save_dir;
+    long steps = 500000;
+    int envs = 2;
+    int threads = 0;
+    long eval_every = 100000;
+    int eval_episodes = 1;
+    int eval_duration = 1000;
+    bool no_video = false;
+    std::uint64_t seed = 0;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "soak", "Vision soak: random actions on a vector of envs, evaluations with video between");
+  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
+  cmd->add_option("--steps", opts->steps, "Env steps in total")
+      ->check(CLI::Range(1L, 100000000000L));
+  cmd->add_option("--envs", opts->envs, "Parallel envs")->check(CLI::Range(1, 1024));
+  cmd->add_option("--threads", opts->threads, "Worker threads (0: one per env, <= cores)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--eval-every", opts->eval_every,
+                  "Env steps between evaluations run beside the live vector")
+      ->check(CLI::Range(1L, 100000000000L));
+  cmd->add_option("--eval-episodes", opts->eval_episodes, "Episodes per evaluation")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--eval-duration", opts->eval_duration, "Env steps per evaluation episode")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_flag("--no-eval-video", opts->no_video, "Evaluate without videos");
+  cmd->add_option("--seed", opts->seed, "Seed of the envs and the random actions")->check(kSeed);
+  cmd->callback([opts] {
+    using Clock = std::chrono::steady_clock;
+    Config config = load_config(opts->config);
+    if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
+    const std::filesystem::path dir = config.save_dir;
+    int evaluations = 0;
+    // An evaluation (own env, renderer and video) on this thread, in its own folder.
+    auto evaluate = [&](const char* when) {
+      Config ec = config;
+      ec.save_dir = (dir / ("soak_eval_" + std::to_string(evaluations++))).string();
+      const eval::EvaluationOptions eo{.episodes = opts->eval_episodes,
+                                       .duration = opts->eval_duration,
+                                       .render = !opts->no_video,
+                                       .seed = opts->seed + 1000,
+                                       .quiet = true};
+      const Clock::time_point t = Clock::now();
+      const eval::EvaluationReport report = eval::evaluate(ec, eo);
+      std::printf("evaluation %d (%s): %zu episodes, mean score %.4f, %.1f s\n", evaluations, when,
+                  report.episodes.size(), report.mean,
+                  std::chrono::duration<double>(Clock::now() - t).count());
+      std::fflush(stdout);
+    };
+
+    const Clock::time_point start = Clock::now();
+    long steps = 0;
+    {
+      auto vec = train::make_babybench_vec_env(config, opts->envs, opts->threads,
+                                               /*training=*/false, opts->seed);
+      const int n = vec->num_envs();
+      const Box& space = vec->action_space();
+      std::vector<double> actions(static_cast<size_t>(n) * space.size());
+      Rng rng(opts->seed + 1);
+      vec->reset(opts->seed);
+      long next_eval = opts->eval_every;
+      long next_print = 10000;
+      while (steps < opts->steps) {
+        for (size_t k = 0; k < actions.size(); ++k) {
+          const size_t j = k % space.size();
+          actions[k] = rng.uniform(space.low[j], space.high[j]);
+        }
+        vec->step(actions);
+        steps += n;
+        if (steps >= next_print) {
+          const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+          const auto [rss, peak] = resident_mb();
+          std::printf("%ld steps, %.0f steps/s, RSS %.0f MB (peak %.0f MB)\n", steps,
+                      steps / seconds, rss, peak);
+          std::fflush(stdout);
+          next_print += 10000;
+        }
+        // The transition that crashed: an evaluation while the vector's contexts live, then
+        // fresh episodes on the pool as a new learn() call starts them.
+        if (steps >= next_eval && steps < opts->steps) {
+          evaluate("beside the vector");
+          vec->reset(opts->seed + steps);
+          next_eval += opts->eval_every;
+        }
+      }
+    }
+    evaluate("after the vector");
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    std::printf(
+        "soak finished: %ld env steps on %d envs, %d evaluations, %.0f s, peak RSS %.0f MB\n",
+        steps, opts->envs, evaluations, seconds, resident_mb().second);
+  });
+}
+
+}  // namespace cradle::apps
