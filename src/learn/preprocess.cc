@@ -24,6 +24,9 @@ void ObservationConfig::bind(Hyperparameters& table) {
             "clip normalised observations to +-this (VecNormalize clip_obs)");
   table.add("pool_touch", &pool_touch,
             "touch as summed force magnitude per MIMo geom instead of the raw skin");
+  table.add("policy_images", &policy_images,
+            "feed image observations (eyes) to the networks; false: vector keys only, the images "
+            "still reach intrinsic rewards");
 }
 
 void ObservationConfig::check_matches(const std::string& checkpoint_config) const {
@@ -36,11 +39,13 @@ void ObservationConfig::check_matches(const std::string& checkpoint_config) cons
   }
   table.apply(values);
   if (saved.normalize_observations != normalize_observations ||
-      saved.clip_observations != clip_observations || saved.pool_touch != pool_touch) {
+      saved.clip_observations != clip_observations || saved.pool_touch != pool_touch ||
+      saved.policy_images != policy_images) {
     throw UserError("observation settings differ (checkpoint: normalize_observations = " +
                     std::string(saved.normalize_observations ? "true" : "false") +
                     ", clip_observations = " + std::to_string(saved.clip_observations) +
-                    ", pool_touch = " + (saved.pool_touch ? "true" : "false") + ")");
+                    ", pool_touch = " + (saved.pool_touch ? "true" : "false") +
+                    ", policy_images = " + (saved.policy_images ? "true" : "false") + ")");
   }
 }
 
@@ -214,6 +219,7 @@ ObservationPipeline::ObservationPipeline(const DictSpace& space, const Observati
   for (int key = 0; key < static_cast<int>(space.entries.size()); ++key) {
     const auto& [name, box] = space.entries[key];
     if (box.dtype == DType::kUInt8 && box.shape.size() == 3) {
+      if (!config.policy_images) continue;
       image_keys_.push_back(key);
       image_bytes_.push_back(box.size());
       shape_.images.push_back({box.shape[0], box.shape[1], box.shape[2]});

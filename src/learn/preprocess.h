@@ -32,6 +32,7 @@ struct ObservationConfig {
   bool normalize_observations = true;  // running mean/std normalisation (VecNormalize norm_obs)
   double clip_observations = 10.0;     // clip after normalising (VecNormalize clip_obs)
   bool pool_touch = true;              // touch pooled per geom instead of the raw skin
+  bool policy_images = true;           // false: the networks never see image keys (rewards may)
   void bind(Hyperparameters& table);
   // Throws UserError when a checkpoint's config text (Hyperparameters::to_text) holds other
   // observation settings: its networks would read differently scaled inputs.

@@ -217,5 +217,22 @@ TEST(Hyperparameters, ParseApplyAndRoundTrip) {
   EXPECT_TRUE(layers.empty());
 }
 
+TEST(ObservationPipeline, PolicyImagesFalseDropsOnlyTheImageKeys) {
+  DictSpace space;
+  space.entries.push_back({"observation", Box::unbounded({7}, DType::kFloat64)});
+  space.entries.push_back({"eye_left", Box::uniform({8, 6, 3}, DType::kUInt8, 0, 255)});
+  space.entries.push_back({"eye_right", Box::uniform({8, 6, 3}, DType::kUInt8, 0, 255)});
+  const ObservationPipeline seeing(space, {}, nullptr);
+  EXPECT_EQ(seeing.shape().vector_size, 7);
+  ASSERT_EQ(seeing.shape().images.size(), 2u);
+  EXPECT_EQ(seeing.shape().images[1], (std::array<int, 3>{8, 6, 3}));
+  const ObservationPipeline blind(space, {.policy_images = false}, nullptr);
+  EXPECT_EQ(blind.shape().vector_size, 7);
+  EXPECT_TRUE(blind.shape().images.empty());
+  // A checkpoint taken with images refuses a run without them, and the reverse.
+  EXPECT_THROW(blind.config().check_matches("policy_images = true\n"), UserError);
+  EXPECT_NO_THROW(blind.config().check_matches("policy_images = false\n"));
+}
+
 }  // namespace
 }  // namespace cradle::learn
