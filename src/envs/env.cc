@@ -1,5 +1,6 @@
 #include "envs/env.h"
 
+#include <cstring>
 #include <limits>
 
 #include "core/error.h"
@@ -18,6 +19,9 @@ ObservationBuffers::ObservationBuffers(const DictSpace& space) {
              sizeof(std::max_align_t);
   }
   storage_.resize(total / sizeof(std::max_align_t) + 1);
+  // Value-initialising max_align_t zeroes its members, not its padding (the bytes after the
+  // long double's 10): zero every byte so an entry nobody wrote reads 0, not stale heap.
+  std::memset(storage_.data(), 0, storage_.size() * sizeof(std::max_align_t));
 }
 
 namespace {

@@ -18,6 +18,7 @@
 #include "envs/babybench.h"
 #include "learn/intrinsic/body_part_novelty.h"
 #include "learn/intrinsic/disagreement.h"
+#include "learn/intrinsic/episode_coverage.h"
 #include "learn/intrinsic/features.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
@@ -609,6 +610,67 @@ TEST(BodyPartNovelty, OnTheSelfTouchEnvCountsWhatInfoRecords) {
   }
   // 200 steps of 60-step episodes: three finished episodes per env, a partial fourth.
   EXPECT_GE(counted, recorded);
+}
+
+// ---- episode_coverage ----
+
+TEST(EpisodeCoverage, PaysEachNewGeomOnceAnEpisodeAndEveryEpisodeAgain) {
+  FakeVec vec(2, touch_space(4));
+  EpisodeCoverage reward(2.0);
+  reward.bind(vec);
+  reward.reset(vec);
+  for (int episode = 0; episode < 3; ++episode) {
+    vec.touches(0, 0) = {5};
+    vec.touches(0, 1) = {5, 9};  // the other hand's touches of the same geom count apart
+    auto r = step(reward, vec);
+    EXPECT_DOUBLE_EQ(r[0], 2.0 * 3 / 68);  // no fading over episodes
+    EXPECT_DOUBLE_EQ(r[1], 0.0);
+    EXPECT_DOUBLE_EQ(step(reward, vec)[0], 0.0);  // nothing new this step
+    vec.touches(0, 0) = {5, 11};
+    EXPECT_DOUBLE_EQ(step(reward, vec)[0], 2.0 / 68);
+    // The episode ends; the autoreset step's empty lists pay nothing.
+    vec.set_done(0, true);
+    step(reward, vec);
+    vec.set_done(0, false);
+    vec.touches(0, 0).clear();
+    vec.touches(0, 1).clear();
+    EXPECT_DOUBLE_EQ(step(reward, vec)[0], 0.0);
+  }
+}
+
+TEST(EpisodeCoverage, EpisodeSumIsTheSelfTouchScoreOnTheRealEnv) {
+  Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_selftouch.yml");
+  config.max_episode_steps = 80;
+  auto vec = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 5);
+  EpisodeCoverage reward;
+  reward.bind(*vec);
+  vec->reset(5);
+  reward.reset(*vec);
+  std::vector<double> actions(vec->action_space().size()), rewards(1);
+  double episode_sum = 0;
+  int episodes = 0;
+  for (int t = 0; t < 160 && episodes < 1; ++t) {
+    for (size_t k = 0; k < actions.size(); ++k) actions[k] = std::sin(0.07 * t + 1.3 * k);
+    vec->step(actions);
+    rewards[0] = 0;
+    reward.compute(*vec, actions, rewards);
+    episode_sum += rewards[0];
+    if (vec->terminated()[0] || vec->truncated()[0]) {
+      const envs::Info& info = vec->info(0);
+      const double score = (info.list(info.find("right_hand_touches")).size() +
+                            info.list(info.find("left_hand_touches")).size()) /
+                           68.0;
+      EXPECT_NEAR(episode_sum, score, 1e-12);
+      ++episodes;
+    }
+  }
+  EXPECT_EQ(episodes, 1);
+
+  // Without a self-touch behaviour there is nothing to pay for: a one-line error.
+  config.behavior = Behavior::kNone;
+  auto plain = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 5);
+  EXPECT_THROW(reward.bind(*plain), UserError);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "learn/intrinsic/body_part_novelty.h"
 #include "learn/intrinsic/disagreement.h"
+#include "learn/intrinsic/episode_coverage.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
 #include "learn/intrinsic/rnd.h"
@@ -31,6 +32,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"touch_count", factory<TouchCount>()},
       {"saliency", factory<Saliency>()},
       {"body_part_novelty", factory<BodyPartNovelty>()},
+      {"episode_coverage", factory<EpisodeCoverage>()},
       {"hand_visibility", factory<HandVisibility>()},
       {"rnd", factory<Rnd>()},
       {"icm", factory<Icm>()},
