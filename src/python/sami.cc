@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "envs/action_check.h"
 #include "python/common.h"
 #include "sami/env.h"
 #include "sami/render.h"
@@ -90,8 +91,10 @@ void bind_sami(py::module_& m) {
           py::arg("seed") = py::none())
       .def("step",
            [](PySamiEnv& e, py::array_t<double, py::array::c_style | py::array::forcecast> a) {
-             const sami::StepResult r =
-                 e.env->step(std::span<const double>(a.data(), static_cast<size_t>(a.size())));
+             const std::span<const double> action(a.data(), static_cast<size_t>(a.size()));
+             // MuJoCo would zero a non-finite control and hand back NaN observations.
+             envs::check_finite_actions(action);
+             const sami::StepResult r = e.env->step(action);
              return py::make_tuple(observation(*e.env), r.reward, r.terminated, r.truncated,
                                    info(*e.env));
            })

@@ -25,128 +25,78 @@ struct Rules {
   int first_cripple_geom = 0;  // geom of crippled joint 0 (joints: j + this)
 };
 
+// The crippled variant of a family: only the mass varies, `cripple` disables units from geom
+// `first_geom` on (`shrink`: and halves their capsules).
+Rules crippled(Rules r, Cripple cripple, int first_geom, bool shrink = false) {
+  r.scaling = Scaling::kMassOnly;
+  r.cripple = cripple;
+  r.first_cripple_geom = first_geom;
+  r.shrink = shrink;
+  return r;
+}
+
 Rules rules(EnvId id) {
+  // The families: reward, observation, control cost and reset noise.
+  const Rules cheetah = {.reward = Reward::kCheetah,
+                         .obs = ObsForm::kVelQpos1,
+                         .scaling = Scaling::kAll,
+                         .ctrl_cost = 0.1,
+                         .pos_noise = 0.001,
+                         .vel_noise = 0.001};
+  const Rules ant = {.reward = Reward::kAnt,
+                     .obs = ObsForm::kVelQpos2,
+                     .scaling = Scaling::kAntSplit,
+                     .ctrl_cost = 0.01,
+                     .uniform_pos = true,
+                     .pos_noise = 0.1,
+                     .vel_noise = 0.1};
+  const Rules planar = {.reward = Reward::kHopWalk,
+                        .obs = ObsForm::kPlanar,
+                        .scaling = Scaling::kAll,
+                        .ctrl_cost = 1e-3,
+                        .uniform_pos = true,
+                        .uniform_vel = true,
+                        .pos_noise = 0.005,
+                        .vel_noise = 0.005};
+  const Rules humanoid = {.reward = Reward::kSlim,
+                          .obs = ObsForm::kHumanoid,
+                          .scaling = Scaling::kAll,
+                          .ctrl_cost = 0.1,
+                          .uniform_pos = true,
+                          .uniform_vel = true,
+                          .pos_noise = 0.01,
+                          .vel_noise = 0.01};
   switch (id) {
     case EnvId::kHalfCheetah:
-      return {Reward::kCheetah,
-              ObsForm::kVelQpos1,
-              Scaling::kAll,
-              Cripple::kNone,
-              false,
-              0.1,
-              false,
-              false,
-              0.001,
-              0.001};
+      return cheetah;
     case EnvId::kCrippleHalfCheetah:
-      return {Reward::kCheetah,
-              ObsForm::kVelQpos1,
-              Scaling::kMassOnly,
-              Cripple::kJoint,
-              false,
-              0.1,
-              false,
-              false,
-              0.001,
-              0.001,
-              3};
+      return crippled(cheetah, Cripple::kJoint, 3);
     case EnvId::kAnt:
-      return {Reward::kAnt,
-              ObsForm::kVelQpos2,
-              Scaling::kAntSplit,
-              Cripple::kNone,
-              false,
-              0.01,
-              true,
-              false,
-              0.1,
-              0.1};
-    case EnvId::kCrippleAnt:
-      return {Reward::kAnt,
-              ObsForm::kCrippleAnt,
-              Scaling::kMassOnly,
-              Cripple::kAntLeg,
-              true,
-              0.01,
-              true,
-              false,
-              0.1,
-              0.1};
-    case EnvId::kHopper:
-      return {Reward::kHopWalk,
-              ObsForm::kPlanar,
-              Scaling::kAll,
-              Cripple::kNone,
-              false,
-              0.1,
-              true,
-              true,
-              0.005,
-              0.005};
+      return ant;
+    case EnvId::kCrippleAnt: {
+      Rules r = crippled(ant, Cripple::kAntLeg, 0, true);
+      r.obs = ObsForm::kCrippleAnt;
+      return r;
+    }
+    case EnvId::kHopper: {
+      Rules r = planar;
+      r.ctrl_cost = 0.1;
+      return r;
+    }
     case EnvId::kCrippleHopper:
-      return {Reward::kHopWalk,
-              ObsForm::kPlanar,
-              Scaling::kMassOnly,
-              Cripple::kJoint,
-              false,
-              1e-3,
-              true,
-              true,
-              0.005,
-              0.005,
-              2};
-    case EnvId::kWalker:
-      return {Reward::kHopWalk,
-              ObsForm::kPlanar,
-              Scaling::kAll,
-              Cripple::kNone,
-              false,
-              1e-3,
-              true,
-              true,
-              0.005,
-              0.005};
     case EnvId::kCrippleWalker:
-      return {Reward::kHopWalk,
-              ObsForm::kPlanar,
-              Scaling::kMassOnly,
-              Cripple::kJoint,
-              false,
-              1e-3,
-              true,
-              true,
-              0.005,
-              0.005,
-              2};
+      return crippled(planar, Cripple::kJoint, 2);
+    case EnvId::kWalker:
+      return planar;
     case EnvId::kWalkerHopper:
-      return {Reward::kHopWalk,
-              ObsForm::kPlanar,
-              Scaling::kMassOnly,
-              Cripple::kJoint,
-              true,
-              1e-3,
-              true,
-              true,
-              0.005,
-              0.005,
-              2};
+      return crippled(planar, Cripple::kJoint, 2, true);
     case EnvId::kSlimHumanoid:
-      return {Reward::kSlim, ObsForm::kHumanoid,
-              Scaling::kAll, Cripple::kNone,
-              false,         0.1,
-              true,          true,
-              0.01,          0.01};
-    case EnvId::kHumanoidStandup:
-      return {Reward::kStandup,
-              ObsForm::kHumanoid,
-              Scaling::kAll,
-              Cripple::kNone,
-              false,
-              0.1,
-              true,
-              true,
-              0.01,
-              0.01};
+      return humanoid;
+    case EnvId::kHumanoidStandup: {
+      Rules r = humanoid;
+      r.reward = Reward::kStandup;
+      return r;
+    }
     case EnvId::kPandaPush:
       break;
   }

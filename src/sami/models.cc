@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 
@@ -42,6 +43,16 @@ void track_camera(XmlWriter& x, double distance, double height, bool from_above 
                     {"mode", "trackcom"},
                     {"pos", nums({0, -distance, height})},
                     {"xyaxes", from_above ? "1 0 0 0 .5 .866" : "1 0 0 0 0 1"}});
+}
+
+// The actuator section: a motor per joint, named after it, with its gear.
+void gear_motors(XmlWriter& x,
+                 std::initializer_list<std::pair<const char*, const char*>> joint_gears) {
+  x.open("actuator");
+  for (const auto& [joint, gear] : joint_gears) {
+    x.leaf("motor", {{"name", joint}, {"joint", joint}, {"gear", gear}});
+  }
+  x.close();
 }
 
 // Half-Cheetah (sami_models.md §1.2): capsules r 0.046 given as pos, half-length and a rotation
@@ -126,17 +137,13 @@ std::string half_cheetah() {
   part({"ffoot", ".13 0 -.18", "-.5 .5", "60", "1.5", ".045 0 -.07", "-.6", ".07"});
   x.close().close().close();
   x.close().close();
-  x.open("actuator");
-  const std::array<std::pair<const char*, const char*>, 6> motors = {{{"bthigh", "120"},
-                                                                      {"bshin", "90"},
-                                                                      {"bfoot", "60"},
-                                                                      {"fthigh", "120"},
-                                                                      {"fshin", "60"},
-                                                                      {"ffoot", "30"}}};
-  for (const auto& [joint, gear] : motors) {
-    x.leaf("motor", {{"name", joint}, {"joint", joint}, {"gear", gear}});
-  }
-  x.close().close();
+  gear_motors(x, {{"bthigh", "120"},
+                  {"bshin", "90"},
+                  {"bfoot", "60"},
+                  {"fthigh", "120"},
+                  {"fshin", "60"},
+                  {"ffoot", "30"}});
+  x.close();
   return x.str();
 }
 
@@ -440,28 +447,24 @@ std::string humanoid() {
     x.close().close();
   }
   x.close().close();
-  x.open("actuator");
-  const std::array<std::pair<const char*, const char*>, 17> motors = {{{"abdomen_y", "100"},
-                                                                       {"abdomen_z", "100"},
-                                                                       {"abdomen_x", "100"},
-                                                                       {"right_hip_x", "100"},
-                                                                       {"right_hip_z", "100"},
-                                                                       {"right_hip_y", "300"},
-                                                                       {"right_knee", "200"},
-                                                                       {"left_hip_x", "100"},
-                                                                       {"left_hip_z", "100"},
-                                                                       {"left_hip_y", "300"},
-                                                                       {"left_knee", "200"},
-                                                                       {"right_shoulder1", "25"},
-                                                                       {"right_shoulder2", "25"},
-                                                                       {"right_elbow", "25"},
-                                                                       {"left_shoulder1", "25"},
-                                                                       {"left_shoulder2", "25"},
-                                                                       {"left_elbow", "25"}}};
-  for (const auto& [joint, gear] : motors) {
-    x.leaf("motor", {{"name", joint}, {"joint", joint}, {"gear", gear}});
-  }
-  x.close().close();
+  gear_motors(x, {{"abdomen_y", "100"},
+                  {"abdomen_z", "100"},
+                  {"abdomen_x", "100"},
+                  {"right_hip_x", "100"},
+                  {"right_hip_z", "100"},
+                  {"right_hip_y", "300"},
+                  {"right_knee", "200"},
+                  {"left_hip_x", "100"},
+                  {"left_hip_z", "100"},
+                  {"left_hip_y", "300"},
+                  {"left_knee", "200"},
+                  {"right_shoulder1", "25"},
+                  {"right_shoulder2", "25"},
+                  {"right_elbow", "25"},
+                  {"left_shoulder1", "25"},
+                  {"left_shoulder2", "25"},
+                  {"left_elbow", "25"}});
+  x.close();
   return x.str();
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 #include <string>
+#include <variant>
 
 #include "core/error.h"
 
@@ -115,14 +116,32 @@ double scale(double value, const TeacherSetup& s) {
   return std::clamp((value - s.reward_lb) / (s.reward_ub - s.reward_lb), 0.0, 1.0);
 }
 
-std::unique_ptr<Teacher> make_adr(const TeacherSetup& s, ParamReader& r) {
-  AdrParams p;
-  r.get("step_size", p.step_size);
-  r.get("boundary_sampling_p", p.boundary_prob);
-  r.get("queue_len", p.queue_len);
-  r.get("max_reward_thr", p.max_reward_thr);
-  r.get("min_reward_thr", p.min_reward_thr);
+// One kwarg: the reference's name and the parameter field it sets.
+template <typename P>
+struct Kwarg {
+  const char* key;
+  std::variant<int P::*, long P::*, float P::*, double P::*, bool P::*, std::string P::*,
+               std::vector<int> P::*>
+      field;
+};
+
+// The kwargs of `table` read into P's defaults; then any key nobody asked for is refused (so a
+// teacher's require and refuse calls come first).
+template <typename P>
+P read_kwargs(ParamReader& r, std::initializer_list<Kwarg<P>> table) {
+  P p;
+  for (const Kwarg<P>& k : table) std::visit([&](auto field) { r.get(k.key, p.*field); }, k.field);
   r.finish();
+  return p;
+}
+
+std::unique_ptr<Teacher> make_adr(const TeacherSetup& s, ParamReader& r) {
+  using P = AdrParams;
+  P p = read_kwargs<P>(r, {{"step_size", &P::step_size},
+                           {"boundary_sampling_p", &P::boundary_prob},
+                           {"queue_len", &P::queue_len},
+                           {"max_reward_thr", &P::max_reward_thr},
+                           {"min_reward_thr", &P::min_reward_thr}});
   // Thresholds follow the returns into [0, 1] when the teacher sees scaled returns.
   if (s.scale_reward) {
     p.max_reward_thr = scale(p.max_reward_thr, s);
@@ -135,55 +154,51 @@ std::unique_ptr<Teacher> make_adr(const TeacherSetup& s, ParamReader& r) {
 }
 
 std::unique_ptr<Teacher> make_riac(const TeacherSetup& s, ParamReader& r) {
-  RiacParams p;
-  r.get("max_region_size", p.max_region_size);
-  r.get("alp_window_size", p.alp_window);
-  r.get("nb_split_attempts", p.nb_split_attempts);
-  r.get("min_region_size", p.min_region_size);
-  r.get("min_dims_range_ratio", p.min_dims_range_ratio);
-  r.get("discard_ratio", p.discard_ratio);
+  using P = RiacParams;
   r.require("sampling_in_leaves_only", false, "regions are drawn among all nodes");
-  r.finish();
+  const P p = read_kwargs<P>(r, {{"max_region_size", &P::max_region_size},
+                                 {"alp_window_size", &P::alp_window},
+                                 {"nb_split_attempts", &P::nb_split_attempts},
+                                 {"min_region_size", &P::min_region_size},
+                                 {"min_dims_range_ratio", &P::min_dims_range_ratio},
+                                 {"discard_ratio", &P::discard_ratio}});
   return make_riac_teacher(s.mins, s.maxs, s.seed, p);
 }
 
 std::unique_ptr<Teacher> make_alp_gmm(const TeacherSetup& s, ParamReader& r) {
-  AlpGmmParams p;
-  r.get("fit_rate", p.fit_rate);
-  r.get("potential_ks", p.potential_ks);
-  r.get("random_task_ratio", p.random_task_ratio);
-  r.get("gmm_fitness_func", p.criterion);
+  using P = AlpGmmParams;
   r.require("nb_em_init", 1, "one EM start per k");
   r.require("weighted_gmm", false, "plain GMMs only");
-  r.finish();
+  P p = read_kwargs<P>(r, {{"fit_rate", &P::fit_rate},
+                           {"potential_ks", &P::potential_ks},
+                           {"random_task_ratio", &P::random_task_ratio},
+                           {"gmm_fitness_func", &P::criterion}});
   if (s.expert_knowledge == ExpertKnowledge::high) p.initial_dist = s.initial_dist;
   return make_alp_gmm_teacher(s.mins, s.maxs, s.seed, std::move(p));
 }
 
 std::unique_ptr<Teacher> make_covar_gmm(const TeacherSetup& s, ParamReader& r) {
-  CovarGmmParams p;
-  r.get("fit_rate", p.fit_rate);
-  r.get("potential_ks", p.potential_ks);
-  r.get("random_task_ratio", p.random_task_ratio);
-  r.get("absolute_lp", p.absolute_lp);
-  r.finish();
+  using P = CovarGmmParams;
+  P p = read_kwargs<P>(r, {{"fit_rate", &P::fit_rate},
+                           {"potential_ks", &P::potential_ks},
+                           {"random_task_ratio", &P::random_task_ratio},
+                           {"absolute_lp", &P::absolute_lp}});
   if (s.expert_knowledge == ExpertKnowledge::high) p.initial_dist = s.initial_dist;
   return make_covar_gmm_teacher(s.mins, s.maxs, s.seed, std::move(p));
 }
 
 std::unique_ptr<Teacher> make_self_paced(const TeacherSetup& s, ParamReader& r) {
-  SelfPacedParams p;
-  r.get("update_frequency", p.update_frequency);
-  r.get("update_offset", p.update_offset);
-  r.get("alpha_offset", p.alpha_offset);
-  r.get("zeta", p.zeta);
-  r.get("max_kl", p.max_kl);
-  r.get("use_avg_performance", p.use_avg_performance);
-  r.get("discount_factor", p.discount_factor);
+  using P = SelfPacedParams;
   r.refuse("std_lower_bound", "no std lower bound");
   r.refuse("kl_threshold", "no std lower bound");
   r.refuse("cg_parameters", "a direct natural-gradient solve");
-  r.finish();
+  P p = read_kwargs<P>(r, {{"update_frequency", &P::update_frequency},
+                           {"update_offset", &P::update_offset},
+                           {"alpha_offset", &P::alpha_offset},
+                           {"zeta", &P::zeta},
+                           {"max_kl", &P::max_kl},
+                           {"use_avg_performance", &P::use_avg_performance},
+                           {"discount_factor", &P::discount_factor}});
   // Only high expert knowledge gives the env's easy region and target (spec §1.3, fixed labels).
   if (s.expert_knowledge == ExpertKnowledge::high) {
     p.initial_dist = s.initial_dist;
@@ -193,21 +208,20 @@ std::unique_ptr<Teacher> make_self_paced(const TeacherSetup& s, ParamReader& r) 
 }
 
 std::unique_ptr<Teacher> make_goal_gan(const TeacherSetup& s, ParamReader& r) {
-  GoalGanParams p;
-  r.get("state_noise_level", p.state_noise_level);
-  r.get("success_distance_threshold", p.success_distance_threshold);
-  r.get("update_size", p.update_size);
-  r.get("n_rollouts", p.n_rollouts);
-  r.get("goid_lb", p.goid_lb);
-  r.get("goid_ub", p.goid_ub);
-  r.get("p_old", p.p_old);
-  r.get("use_pretrained_samples", p.use_pretrained_samples);
-  r.get("pretrain_samples", p.pretrain_samples);
-  r.get("pretrain_iterations", p.pretrain_iterations);
-  r.get("train_iterations", p.train_iterations);
-  r.get("batch_size", p.batch_size);
-  r.get("lr", p.lr);
-  r.finish();
+  using P = GoalGanParams;
+  P p = read_kwargs<P>(r, {{"state_noise_level", &P::state_noise_level},
+                           {"success_distance_threshold", &P::success_distance_threshold},
+                           {"update_size", &P::update_size},
+                           {"n_rollouts", &P::n_rollouts},
+                           {"goid_lb", &P::goid_lb},
+                           {"goid_ub", &P::goid_ub},
+                           {"p_old", &P::p_old},
+                           {"use_pretrained_samples", &P::use_pretrained_samples},
+                           {"pretrain_samples", &P::pretrain_samples},
+                           {"pretrain_iterations", &P::pretrain_iterations},
+                           {"train_iterations", &P::train_iterations},
+                           {"batch_size", &P::batch_size},
+                           {"lr", &P::lr}});
   // High expert knowledge: always pretrained, on the env's easy region.
   if (s.expert_knowledge == ExpertKnowledge::high) {
     p.use_pretrained_samples = true;
@@ -217,12 +231,11 @@ std::unique_ptr<Teacher> make_goal_gan(const TeacherSetup& s, ParamReader& r) {
 }
 
 std::unique_ptr<Teacher> make_setter_solver(const TeacherSetup& s, ParamReader& r) {
-  SetterSolverParams p;
-  r.get("update_frequency", p.update_frequency);
-  r.get("setter_loss_noise_ub", p.setter_loss_noise_ub);
-  r.get("setter_hidden_size", p.setter_hidden_size);
-  r.get("lr", p.lr);
-  r.finish();
+  using P = SetterSolverParams;
+  const P p = read_kwargs<P>(r, {{"update_frequency", &P::update_frequency},
+                                 {"setter_loss_noise_ub", &P::setter_loss_noise_ub},
+                                 {"setter_hidden_size", &P::setter_hidden_size},
+                                 {"lr", &P::lr}});
   return make_setter_solver_teacher(s.mins, s.maxs, s.seed, p);
 }
 

@@ -51,6 +51,29 @@ def test_bad_names_splits_and_actions_are_value_errors():
         env.step(np.zeros(2))
 
 
+@pytest.mark.parametrize("name", ["Hopper", "PandaPush"])
+def test_non_finite_actions_are_refused_and_leave_the_state_alone(name):
+    env = cradle.sami.make(name)
+    obs, _ = env.reset(seed=3)
+    size = env.action_space.shape[0]
+    for value in (np.nan, np.inf, -np.inf):
+        action = np.zeros(size)
+        action[size - 1] = value
+        with pytest.raises(ValueError) as raised:
+            env.step(action)
+        message = str(raised.value)
+        assert "\n" not in message
+        assert f"action {size - 1} is" in message and "expected finite values" in message
+    # Nothing was stepped: the first finite step matches a fresh env's.
+    fresh = cradle.sami.make(name)
+    fresh.reset(seed=3)
+    after, reward, *_ = env.step(np.zeros(size))
+    expected, expected_reward, *_ = fresh.step(np.zeros(size))
+    assert reward == expected_reward
+    for key in expected:
+        np.testing.assert_array_equal(after[key], expected[key])
+
+
 def test_user_task_sets_from_yaml(tmp_path):
     path = tmp_path / "sets.yml"
     path.write_text("task_sets:\n  - mass: [2.0]\n    cripple: [[1]]\n")

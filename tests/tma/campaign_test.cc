@@ -4,7 +4,6 @@
 // and the analysis of the results. Runs use tests/tma_campaign/fake_tma_run.py in place of
 // `cradle tma run` (a synthetic run folder in the agreed format, in well under a second).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "envs/tma/tma_env.h"
+#include "fixture.h"
 #include "learn/registry.h"
 #include "learn/run_files.h"
 #include "learn/vector_env.h"
@@ -25,21 +25,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using cradle::test::run_cradle;
+using cradle::test::RunResult;
 
-CliResult shell(const std::string& cmd) {
-  CliResult r;
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
-}
-
-CliResult cradle(const std::string& args) { return shell(std::string(CRADLE_BINARY) + " " + args); }
+// A shell command, stdout and stderr together.
+RunResult shell(const std::string& cmd) { return cradle::test::run(cmd + " 2>&1"); }
 
 std::vector<std::string> config_lines(const std::string& text) {
   std::vector<std::string> lines;
@@ -87,7 +77,7 @@ const std::vector<std::string> kSeedDirs = {
 
 // Every figure and table of the analysis of the mini campaign.
 void expect_analysis(const fs::path& results) {
-  const CliResult r = cradle("tma analyze " + results.string());
+  const RunResult r = run_cradle("tma analyze " + results.string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("4 runs, baseline rnd"), std::string::npos) << r.out;
   for (const char* f : {"curves_criterion_1_none.png", "train_return_criterion_1_none.png",
@@ -105,7 +95,8 @@ void expect_analysis(const fs::path& results) {
 }
 
 TEST(TmaCampaign, GeneratesBothExperimentsWithTheReferenceSeeds) {
-  CliResult r = cradle("tma campaign generate alp --teacher ALP-GMM --teacher-param fit_rate=150");
+  RunResult r =
+      run_cradle("tma campaign generate alp --teacher ALP-GMM --teacher-param fit_rate=150");
   ASSERT_EQ(r.status, 0) << r.out;
   std::vector<std::string> lines = config_lines(r.out);
   // 3 EK x (criteria 1-4 + 4 criterion-5 variants) + 3 Parkour + 3 upper-baseline lines.
@@ -127,11 +118,11 @@ TEST(TmaCampaign, GeneratesBothExperimentsWithTheReferenceSeeds) {
   EXPECT_EQ(count(lines, "--*allow_expert_knowledge high"), 9);
 
   // Random: only the no-EK block (the analysis duplicates it); ADR: no "none", 32 seeds.
-  r = cradle("tma campaign generate rnd --teacher Random");
+  r = run_cradle("tma campaign generate rnd --teacher Random");
   lines = config_lines(r.out);
   EXPECT_EQ(lines.size(), 12u);
   EXPECT_EQ(count(lines, "allow_expert_knowledge low"), 3);  // Parkour is low EK
-  r = cradle("tma campaign generate adr --teacher ADR");
+  r = run_cradle("tma campaign generate adr --teacher ADR");
   lines = config_lines(r.out);
   EXPECT_EQ(lines.size(), 21u);
   EXPECT_EQ(count(lines, "allow_expert_knowledge none"), 0);
@@ -139,8 +130,8 @@ TEST(TmaCampaign, GeneratesBothExperimentsWithTheReferenceSeeds) {
 
   // Mini preset and overrides scale the budget and the seeds.
   const fs::path dir = fresh("generate");
-  r = cradle("tma campaign generate m --teacher Random --preset mini --out " +
-             (dir / "m.txt").string());
+  r = run_cradle("tma campaign generate m --teacher Random --preset mini --out " +
+                 (dir / "m.txt").string());
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream in(dir / "m.txt");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -149,14 +140,14 @@ TEST(TmaCampaign, GeneratesBothExperimentsWithTheReferenceSeeds) {
   EXPECT_EQ(count(lines, "--nb_env_steps 0.02 --test_every 10000"), 12);
   EXPECT_EQ(count(lines, "--nb_test_episodes 10 "), 12);
   EXPECT_EQ(count(lines, "--test_set"), 0);
-  r = cradle("tma campaign generate m --teacher Random --steps 2 --seeds 4");
+  r = run_cradle("tma campaign generate m --teacher Random --steps 2 --seeds 4");
   lines = config_lines(r.out);
   EXPECT_EQ(count(lines, "--seeds 4+8 "), 1);
   EXPECT_EQ(count(lines, "--nb_env_steps 2 --test_every 50000"), 12);
   EXPECT_EQ(count(lines, "--test_set parametric_stumps_test_set"), 9);
   // The generated file is a valid campaign: the dry run lists every seed.
-  r = cradle("tma campaign launch " + (dir / "m.txt").string() + " --local --dry-run --results " +
-             (dir / "res").string());
+  r = run_cradle("tma campaign launch " + (dir / "m.txt").string() +
+                 " --local --dry-run --results " + (dir / "res").string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(config_lines(r.out).size(), 8u * 2 + 3 * 2 + 1 * 4);
   EXPECT_NE(r.out.find("--exp_name m_parkour_embodiment_fish --seed 5 --out"), std::string::npos)
@@ -186,7 +177,7 @@ TEST(TmaCampaign, BadInputIsOneLineError) {
       "tma campaign launch " + write("--seeds 1 --name a\n") + " --jobs 0",
       "tma analyze " + (dir / "nothing").string()};
   for (const std::string& args : cases) {
-    const CliResult r = cradle(args);
+    const RunResult r = run_cradle(args);
     EXPECT_EQ(r.status, 1) << args << "\n" << r.out;
     EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << "\n" << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << "\n" << r.out;
@@ -200,7 +191,7 @@ TEST(TmaCampaign, LocalPoolRunsEverySeedResumesAndAnalyses) {
   const fs::path results = dir / "results";
   const std::string launch = "tma campaign launch " + file.string() +
                              " --local --jobs 2 --results " + results.string() + " " + kRunner;
-  CliResult r = cradle(launch);
+  RunResult r = run_cradle(launch);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("4 runs finished"), std::string::npos) << r.out;
   for (const std::string& d : kSeedDirs) {
@@ -220,11 +211,11 @@ TEST(TmaCampaign, LocalPoolRunsEverySeedResumesAndAnalyses) {
   EXPECT_EQ(cmd.back(), (results / kSeedDirs[3]).string());
 
   // A second launch refuses to overwrite; --resume runs only the unfinished seed, resumed.
-  r = cradle(launch);
+  r = run_cradle(launch);
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("use --resume"), std::string::npos) << r.out;
   fs::remove(results / kSeedDirs[1] / "finished");
-  r = cradle(launch + " --resume");
+  r = run_cradle(launch + " --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("3 finished seeds skipped"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1 runs finished"), std::string::npos) << r.out;
@@ -239,7 +230,7 @@ TEST(TmaCampaign, LocalPoolRunsEverySeedResumesAndAnalyses) {
   EXPECT_NE(r.out.find("alp_c1_allow_expert_knowledge_none seed 4 (exit 3"), std::string::npos)
       << r.out;
   EXPECT_FALSE(fs::exists(results / kSeedDirs[2] / "finished"));
-  ASSERT_EQ(cradle(launch + " --resume").status, 0);
+  ASSERT_EQ(run_cradle(launch + " --resume").status, 0);
 
   expect_analysis(results);
   fs::remove_all(dir);
@@ -252,7 +243,7 @@ TEST(TmaCampaign, DryRunPrintsOneArrayPerLineWithPinnedSeeds) {
   const std::string launch = "tma campaign launch " + (dir / "c.txt").string() +
                              " --slurm --dry-run --sbatch --time=20:00:00 --results " +
                              (dir / "res").string() + " " + kRunner;
-  CliResult r = cradle(launch);
+  RunResult r = run_cradle(launch);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("#SBATCH --array=0-1\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("#SBATCH --array=0\n"), std::string::npos) << r.out;
@@ -271,7 +262,7 @@ TEST(TmaCampaign, DryRunPrintsOneArrayPerLineWithPinnedSeeds) {
     fs::create_directories(d);
     std::ofstream(d / "finished") << "{}\n";
   }
-  r = cradle(launch + " --resume");
+  r = run_cradle(launch + " --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("8 finished seeds skipped"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("#SBATCH --array=1\n"), std::string::npos) << r.out;
@@ -283,14 +274,14 @@ TEST(TmaCampaign, SlurmRunsTheMiniCampaign) {
   const std::string script = std::string(CRADLE_SOURCE_DIR) + "/scripts/slurm-local.sh";
   const std::string conf = "SLURM_CONF=/tmp/cradle-slurm/slurm.conf ";
   const bool was_up = shell(conf + "sinfo -h").status == 0;
-  const CliResult up = shell(script + " start");
+  const RunResult up = shell(script + " start");
   if (up.status != 0) {
     GTEST_SKIP() << "a one-node Slurm cannot start here (" << up.out
                  << "); the local-pool test covers the launcher";
   }
   const fs::path dir = fresh("slurm");
   const fs::path results = dir / "results";
-  const CliResult r =
+  const RunResult r =
       shell(conf + CRADLE_BINARY + " tma campaign launch " + mini_campaign(dir).string() +
             " --slurm --wait --seeds-per-job 2 --results " + results.string() + " " + kRunner);
   EXPECT_EQ(r.status, 0) << r.out;
@@ -310,8 +301,8 @@ TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
   const fs::path dir = fresh("real");
   std::string lines;
   for (const char* teacher : {"Random", "ALP-GMM"}) {
-    const CliResult r = cradle(std::string("tma campaign generate ") + teacher + " --teacher " +
-                               teacher + " --preset mini --steps 0.002 --test-episodes 4");
+    const RunResult r = run_cradle(std::string("tma campaign generate ") + teacher + " --teacher " +
+                                   teacher + " --preset mini --steps 0.002 --test-episodes 4");
     ASSERT_EQ(r.status, 0) << r.out;
     for (const std::string& l : config_lines(r.out)) {
       if (l.find("--experiment criterion_1 ") != std::string::npos &&
@@ -322,8 +313,8 @@ TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
   }
   std::ofstream(dir / "c.txt") << lines;
   const fs::path results = dir / "results";
-  CliResult r = cradle("tma campaign launch " + (dir / "c.txt").string() +
-                       " --local --jobs 2 --results " + results.string());
+  RunResult r = run_cradle("tma campaign launch " + (dir / "c.txt").string() +
+                           " --local --jobs 2 --results " + results.string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("4 runs finished"), std::string::npos) << r.out;
   const fs::path run = results / "ALP-GMM_criterion_1_allow_expert_knowledge_none" /
@@ -336,7 +327,7 @@ TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["arguments"]["seed"], 1);
   EXPECT_EQ(j["arguments"]["max_stump_h"], 9.0);
-  r = cradle("tma analyze " + results.string());
+  r = run_cradle("tma analyze " + results.string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("4 runs, baseline Random"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(results / "analysis" / "curves_criterion_1_none.png"));
@@ -365,8 +356,8 @@ TEST(TmaCampaign, VideoRendersTheCheckpointOnATestTask) {
     cradle::learn::save_run_checkpoint(dir / "checkpoints" / "latest.ckpt", *learner, nullptr, {});
   }
   const fs::path out = dir / "task1.mp4";
-  CliResult r =
-      cradle("tma video --run " + dir.string() + " --test-task 1 --steps 40 --out " + out.string());
+  RunResult r = run_cradle("tma video --run " + dir.string() + " --test-task 1 --steps 40 --out " +
+                           out.string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("test task 1: return"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("after 0 training steps"), std::string::npos) << r.out;
@@ -374,7 +365,7 @@ TEST(TmaCampaign, VideoRendersTheCheckpointOnATestTask) {
   for (const std::string& args :
        {"tma video --run " + dir.string() + " --test-task 2",
         "tma video --run " + (dir / "none").string() + " --test-task 0"}) {
-    r = cradle(args);
+    r = run_cradle(args);
     EXPECT_EQ(r.status, 1) << args << "\n" << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
   }

@@ -1,34 +1,23 @@
 // `cradle tma`: info lists every embodiment, random writes a video and a PNG, bad input is a
 // one-line error with exit status 1.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliResult cradle(const std::string& args) {
-  const std::string cmd = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
-}
+using cradle::test::run_cradle;
+using cradle::test::RunResult;
 
 TEST(TmaCli, InfoListsEveryEmbodiment) {
-  const CliResult r = cradle("tma info");
+  const RunResult r = run_cradle("tma info");
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.size(), 13u);
@@ -39,7 +28,7 @@ TEST(TmaCli, InfoListsEveryEmbodiment) {
 TEST(TmaCli, RandomWritesVideoAndPng) {
   const fs::path dir = fs::temp_directory_path() / "cradle_tma_cli_test";
   fs::create_directories(dir);
-  const CliResult r = cradle(
+  const RunResult r = run_cradle(
       "tma random --env parkour --embodiment fish --task input_vector=0,0,0 --task "
       "water_level=1 --steps 20 --video " +
       (dir / "fish.mp4").string() + " --png " + (dir / "fish.png").string() + " --png-step 5");
@@ -56,7 +45,7 @@ TEST(TmaCli, BadInputIsOneLineError) {
        {"tma random --embodiment centipede", "tma random --env hexagon",
         "tma random --task stump_height=abc", "tma random --task stump_height=20",
         "tma random --env parkour --task input_vector=0,0", "tma bench --embodiment nope"}) {
-    const CliResult r = cradle(args);
+    const RunResult r = run_cradle(args);
     EXPECT_EQ(r.status, 1) << args;
     EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << ": " << r.out;
     EXPECT_EQ(r.out.find('\n'), r.out.size() - 1) << args << ": " << r.out;

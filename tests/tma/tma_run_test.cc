@@ -1,7 +1,6 @@
 // `cradle tma run`: tiny runs of both students write the run folder of docs/tma_run.md, resume
 // continues every file from the checkpoint, and bad input is a one-line error.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -12,24 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "fixture.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliResult cradle(const std::string& args) {
-  const std::string cmd = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (fgets(buf, sizeof(buf), pipe)) r.out += buf;
-  r.status = WEXITSTATUS(pclose(pipe));
-  return r;
-}
+using cradle::test::run_cradle;
+using cradle::test::RunResult;
 
 std::vector<std::string> lines(const fs::path& file) {
   std::ifstream in(file);
@@ -73,7 +62,7 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
       "--allow_expert_knowledge high --keep_periodical_task_samples 500 "
       "--out " +
       dir.string();
-  CliResult r = cradle(args + " --nb_env_steps 0.002");
+  RunResult r = run_cradle(args + " --nb_env_steps 0.002");
   ASSERT_EQ(r.status, 0) << r.out;
 
   // run.json: arguments, bounds, commit, version.
@@ -130,7 +119,7 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
 
   // A row written after the checkpoint (a crash) is cut off on resume and kept aside.
   std::ofstream(dir / "progress.csv", std::ios::app) << "9,9999,1,1,1,1,1,1,1\n";
-  r = cradle(args + " --nb_env_steps 0.003 --resume");
+  r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(lines(dir / "progress.after-checkpoint.csv").size(), 1u);
   progress = lines(dir / "progress.csv");
@@ -148,14 +137,15 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_EQ(train, std::stol(cells(progress[4])[2]));
 
   // Resuming with another teacher is refused.
-  r = cradle(kSac + "--teacher Random --out " + dir.string() + " --nb_env_steps 0.004 --resume");
+  r = run_cradle(kSac + "--teacher Random --out " + dir.string() +
+                 " --nb_env_steps 0.004 --resume");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.out.find("cradle: error: --resume: --teacher"), std::string::npos) << r.out;
 }
 
 TEST(TmaRun, PpoStudentWithStudentReset) {
   const fs::path dir = fresh("cradle_tma_run_ppo");
-  const CliResult r = cradle(
+  const RunResult r = run_cradle(
       "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.001 "
       "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
       "--hp batch_size=50 --hp pi_layers=16 --hp vf_layers=16 --out " +
@@ -178,8 +168,8 @@ TEST(TmaRun, BadInputIsAOneLineError) {
        {"--student dqn", "--teacher Teacherless", "--teacher ADR --allow_expert_knowledge none",
         "--allow_expert_knowledge some", "--nb_env_steps -1", "--test_set no_such_set",
         "--embodiment tripod", "--teacher-param fit_rat=3", "--hp n_stepz=3"}) {
-    const CliResult r =
-        cradle("tma run --no-progress --out " + dir.string() + " " + std::string(bad));
+    const RunResult r =
+        run_cradle("tma run --no-progress --out " + dir.string() + " " + std::string(bad));
     EXPECT_EQ(r.status, 1) << bad << ": " << r.out;
     EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << bad << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << bad << ": " << r.out;

@@ -5,15 +5,7 @@
 namespace cradle::learn::meta {
 
 ContrastSample sample_all(const TrajectoryReplay& replay, int batch, double neg_ratio, Rng& rng) {
-  const int negatives = negative_count(batch, neg_ratio);
-  std::vector<long> drawn = sample_even(replay, batch, rng);
-  sort_by_return(replay, drawn);
-  ContrastSample out;
-  out.positives.assign(drawn.begin(), drawn.end() - negatives);
-  out.negatives.assign(drawn.end() - negatives, drawn.end());
-  out.positive_return = mean_return(replay, out.positives);
-  out.negative_return = mean_return(replay, out.negatives);
-  return out;
+  return split_by_return(replay, sample_even(replay, batch, rng), negative_count(batch, neg_ratio));
 }
 
 }  // namespace cradle::learn::meta

@@ -69,6 +69,17 @@ double mean_return(const TrajectoryReplay& replay, const std::vector<long>& indi
   return indices.empty() ? 0.0 : sum / static_cast<double>(indices.size());
 }
 
+ContrastSample split_by_return(const TrajectoryReplay& replay, std::vector<long> drawn,
+                               int negatives) {
+  sort_by_return(replay, drawn);
+  ContrastSample out;
+  out.positives.assign(drawn.begin(), drawn.end() - negatives);
+  out.negatives.assign(drawn.end() - negatives, drawn.end());
+  out.positive_return = mean_return(replay, out.positives);
+  out.negative_return = mean_return(replay, out.negatives);
+  return out;
+}
+
 ContrastSample sample_contrast(Contrast contrast, const TrajectoryReplay& replay, int batch,
                                double neg_ratio, Rng& rng) {
   switch (contrast) {

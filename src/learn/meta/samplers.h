@@ -52,5 +52,9 @@ ContrastSample sample_contrast(Contrast contrast, const TrajectoryReplay& replay
 std::vector<long> sample_even(const TrajectoryReplay& replay, int count, Rng& rng);
 void sort_by_return(const TrajectoryReplay& replay, std::vector<long>& indices);
 double mean_return(const TrajectoryReplay& replay, const std::vector<long>& indices);
+// SaTESAC's and SaCCMAll's split: `drawn` sorted by return, the last `negatives` the negatives
+// and the rest the positives, with their mean returns.
+ContrastSample split_by_return(const TrajectoryReplay& replay, std::vector<long> drawn,
+                               int negatives);
 
 }  // namespace cradle::learn::meta

@@ -5,16 +5,8 @@
 namespace cradle::learn::meta {
 
 ContrastSample sample_one(const TrajectoryReplay& replay, int batch, double neg_ratio, Rng& rng) {
-  const int negatives = negative_count(batch, neg_ratio);
   const int env = static_cast<int>(rng.next() % replay.envs());
-  std::vector<long> drawn = replay.sample(env, batch, rng);
-  sort_by_return(replay, drawn);
-  ContrastSample out;
-  out.positives.assign(drawn.begin(), drawn.end() - negatives);
-  out.negatives.assign(drawn.end() - negatives, drawn.end());
-  out.positive_return = mean_return(replay, out.positives);
-  out.negative_return = mean_return(replay, out.negatives);
-  return out;
+  return split_by_return(replay, replay.sample(env, batch, rng), negative_count(batch, neg_ratio));
 }
 
 }  // namespace cradle::learn::meta
