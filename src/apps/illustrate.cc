@@ -29,12 +29,14 @@
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
 #include "learn/vector_env.h"
+#include "train/loop.h"
 
 namespace cradle::apps {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using train::csv_cell;
 
 struct IllustrateOptions {
   std::string env;
@@ -70,13 +72,6 @@ std::string learner_name(const std::string& algorithm) {
     }
   }
   throw UserError("--algorithm '" + algorithm + "': expected one of PPO, SAC, TD3, DDPG, A2C");
-}
-
-std::string cell(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
 }
 
 // Learning curves of a training run, one point per update (NaN where no episode ended).
@@ -196,15 +191,18 @@ void run(const IllustrateOptions& o) {
     // Success rate of the episodes that ended since the last update.
     long successes_seen = 0, ended_seen = 0;
     Curves curves;
-    learner->learn(total, [&](const learn::TrainStats& s) {
+    // The shared training loop; models are saved as the run goes (no boundaries, so one learn()
+    // call and the reference's episodes).
+    const auto report = [&](const learn::TrainStats& s) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = ended > ended_seen ? static_cast<double>(successes - successes_seen) /
                                                    static_cast<double>(ended - ended_seen)
                                              : std::nan("");
       successes_seen = successes;
       ended_seen = ended;
-      csv << s.steps << "," << cell(elapsed) << "," << cell(s.sps) << "," << cell(s.episodic_return)
-          << "," << cell(s.episodic_length) << "," << cell(rate) << "," << s.episodes << "\n";
+      csv << s.steps << "," << csv_cell(elapsed) << "," << csv_cell(s.sps) << ","
+          << csv_cell(s.episodic_return) << "," << csv_cell(s.episodic_length) << ","
+          << csv_cell(rate) << "," << s.episodes << "\n";
       csv.flush();
       curves.steps.push_back(static_cast<double>(s.steps));
       curves.returns.push_back(s.episodic_return);
@@ -217,19 +215,21 @@ void run(const IllustrateOptions& o) {
       if (s.steps - last_report >= std::max<long>(o.train_for / 20, 1) || s.steps >= total) {
         last_report = s.steps;
         std::printf("  %9ld steps  %6.0f s  %6.0f steps/s  return %s  length %s  success %s\n",
-                    s.steps, elapsed, s.sps, cell(s.episodic_return).c_str(),
-                    cell(s.episodic_length).c_str(), cell(rate).c_str());
+                    s.steps, elapsed, s.sps, csv_cell(s.episodic_return).c_str(),
+                    csv_cell(s.episodic_length).c_str(), csv_cell(rate).c_str());
         std::fflush(stdout);
       }
       return true;
-    });
+    };
+    train::run_loop(*learner, {.total_steps = total, .report = report});
     if (learner->steps() > saved_at) {
       learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
     }
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
-    if (!curves.steps.empty() && plot_curves(curves, id + " " + (o.algorithm.empty() ? algorithm : o.algorithm), dir)) {
+    if (!curves.steps.empty() &&
+        plot_curves(curves, id + " " + (o.algorithm.empty() ? algorithm : o.algorithm), dir)) {
       std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
     }
   }

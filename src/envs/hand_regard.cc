@@ -9,7 +9,9 @@
 namespace cradle::envs {
 
 HandRegard::HandRegard(const mjModel* m, double half_angle_deg, bool occlusion)
-    : cos_half_angle_(std::cos(half_angle_deg * std::numbers::pi / 180)), occlusion_(occlusion) {
+    : half_angle_deg_(half_angle_deg),
+      cos_half_angle_(std::cos(half_angle_deg * std::numbers::pi / 180)),
+      occlusion_(occlusion) {
   const char* cameras[2] = {"eye_right", "eye_left"};
   const char* hands[2] = {"right_hand", "left_hand"};
   for (int i = 0; i < 2; ++i) {
@@ -47,6 +49,26 @@ double HandRegard::score(const Info& info, int steps) const {
   double sum = 0;
   for (int slot : pair_slot_) sum += info.number(slot);
   return sum / (4.0 * steps);
+}
+
+EvaluationPanels HandRegard::evaluation_panels() const {
+  return {.up = EvaluationPanels::View::kBinocular,
+          .trace = EvaluationPanels::Trace{
+              .key = "gaze_angle",
+              .title = "Gaze-hand angle (evaluation episode 0)",
+              .y_label = "angle (°)",
+              .file = "gaze_hand_angle.png",
+              .labels = {"right eye - right hand", "right eye - left hand", "left eye - right hand",
+                         "left eye - left hand"},
+              .y_range = {0.0, 180.0},
+              .threshold = std::pair{half_angle_deg_, "central field of view"}}};
+}
+
+void HandRegard::trace(const mjData* d, std::span<double> values) const {
+  // Eye-major, as the info's pairs: right eye (right, left hand), then left eye.
+  for (int eye = 0; eye < 2; ++eye) {
+    for (int hand = 0; hand < 2; ++hand) values[2 * eye + hand] = gaze_angle(d, eye, hand);
+  }
 }
 
 std::array<double, 3> HandRegard::palm_centre(const mjData* d, int hand) const {

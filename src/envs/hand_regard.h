@@ -26,6 +26,10 @@ class HandRegard final : public Task {
   double after_step(const mjModel* m, const mjData* d, Info& info);
   // The mean over the four eye-hand pairs of the fraction of steps in view.
   double score(const Info& info, int steps) const override;
+  // The binocular view above the top camera, and the four gaze-hand angles per step against the
+  // central field of view.
+  EvaluationPanels evaluation_panels() const override;
+  void trace(const mjData* d, std::span<double> values) const override;
 
   // Angle (deg) between an eye's optical axis and the direction to a hand's palm centre
   // (eye 0 right, 1 left; hand 0 right, 1 left).
@@ -36,7 +40,7 @@ class HandRegard final : public Task {
   std::array<double, 3> palm_centre(const mjData* d, int hand) const;
 
  private:
-  double cos_half_angle_;
+  double half_angle_deg_, cos_half_angle_;
   bool occlusion_;
   std::array<int, 2> eye_camera_{};  // eye_right, eye_left
   std::array<int, 2> eye_body_{};

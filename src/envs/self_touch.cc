@@ -54,6 +54,19 @@ double SelfTouch::score(const Info& info, int) const {
          (2 * kReferenceGeomsPerHand);
 }
 
+EvaluationPanels SelfTouch::evaluation_panels() const {
+  return {.up = EvaluationPanels::View::kTouches,
+          .hand_geoms = {hand_geoms_[0], hand_geoms_[1]},
+          .mimo_geoms = mimo_geoms_,
+          .geom_lists =
+              EvaluationPanels::GeomLists{.keys = {"right_hand_touches", "left_hand_touches"},
+                                          .labels = {"right hand", "left hand"},
+                                          .title = "Self-touch coverage per body part (evaluation)",
+                                          .union_label = "union of touches so far",
+                                          .file = "touch_coverage.png",
+                                          .union_denominator = 2 * kReferenceGeomsPerHand}};
+}
+
 void SelfTouch::record(int hand, int other, Info& info) {
   // Only MIMo's own geoms count, never the hand's own (palm and fingers).
   if (!is_mimo_[other] || hand_of_geom_[other] == hand || seen_[hand][other]) return;

@@ -29,6 +29,8 @@ class SelfTouch final : public Task {
   double after_step(const mjModel* m, const mjData* d, Info& info);
   // (|right| + |left|) / 68.
   double score(const Info& info, int steps) const override;
+  // The skin map above the top camera, and the touch lists charted per body part.
+  EvaluationPanels evaluation_panels() const override;
 
   // Geoms that belong to a hand (0 right, 1 left).
   const std::vector<int>& hand_geoms(int hand) const { return hand_geoms_[hand]; }

@@ -7,8 +7,13 @@
 
 #include <mujoco/mujoco.h>
 
+#include <array>
 #include <memory>
+#include <optional>
 #include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/config.h"
 #include "core/rng.h"
@@ -16,6 +21,35 @@
 #include "envs/mimo_core.h"
 
 namespace cradle::envs {
+
+// What an evaluation shows of a task: eval/ draws it without knowing which task it is.
+struct EvaluationPanels {
+  // The video's right-column panels, up then down: a camera (side2, top), the eyes' red/cyan
+  // anaglyph, or the skin map (MIMo's skin from above, hand contacts highlighted).
+  enum class View { kSide2, kTop, kBinocular, kTouches };
+  View up = View::kSide2, down = View::kTop;
+  // The skin map's highlights: each hand's geoms (0 right, 1 left) and MIMo's geoms.
+  std::array<std::vector<int>, 2> hand_geoms;
+  std::vector<int> mimo_geoms;
+  // Info keys holding geom lists (e.g. each hand's touches): a bar chart of the fraction of each
+  // MIMo body's geoms they hold over the evaluation, and a training-log curve of their union
+  // over episodes divided by `union_denominator`.
+  struct GeomLists {
+    std::vector<std::string> keys, labels;
+    std::string title, union_label, file;  // file: the chart's PNG name
+    double union_denominator = 1;
+  };
+  std::optional<GeomLists> geom_lists;
+  // Values the task measures every step (Task::trace), saved with each trajectory under `key`
+  // and drawn for the first evaluation episode, one line per label.
+  struct Trace {
+    std::string key, title, y_label, file;  // file: the plot's PNG name
+    std::vector<std::string> labels;
+    std::pair<double, double> y_range{0, 1};
+    std::optional<std::pair<double, std::string>> threshold;  // a horizontal line and its label
+  };
+  std::optional<Trace> trace;
+};
 
 class Task {
  public:
@@ -44,6 +78,10 @@ class Task {
   virtual double after_step(const MimoCore& core, Info& info) = 0;
   // Score of an episode of `steps` env steps from its info (NaN: the task measures nothing).
   virtual double score(const Info& info, int steps) const;
+  // What an evaluation of the task shows (default: two cameras, nothing else).
+  virtual EvaluationPanels evaluation_panels() const { return {}; }
+  // The per-step values of evaluation_panels().trace (as many as its labels) for the state `d`.
+  virtual void trace(const mjData* d, std::span<double> values) const { (void)d, (void)values; }
 };
 
 // The BabyBench behaviour named by the config ("none" measures nothing).

@@ -13,8 +13,6 @@
 #include "core/jsonl.h"
 #include "core/npz.h"
 #include "core/rng.h"
-#include "envs/hand_regard.h"
-#include "envs/self_touch.h"
 #include "eval/figures.h"
 #include "eval/frames.h"
 #include "eval/log_check.h"
@@ -27,30 +25,34 @@ namespace fs = std::filesystem;
 
 // Per-step record of one episode, for its trajectory file and plots.
 struct Trajectory {
-  std::vector<double> qpos;         // steps x nq
-  std::vector<float> actions;       // steps x action dim
-  std::vector<std::string> infos;   // steps JSON texts
-  std::vector<double> gaze_angles;  // steps x 4 (hand regard)
+  std::vector<double> qpos;        // steps x nq
+  std::vector<float> actions;      // steps x action dim
+  std::vector<std::string> infos;  // steps JSON texts
+  std::vector<double> trace;       // steps x the task's trace width
 };
 
-// Score over training episodes from the log (per-episode score, plus the cumulative union for
-// self-touch).
-void plot_training_log(Behavior behavior, const std::vector<nlohmann::json>& entries,
-                       const fs::path& file, Figures& figures) {
+// Score over training episodes from the log (per-episode score, plus the cumulative union of
+// the task's geom lists when it has some).
+void plot_training_log(const envs::EvaluationPanels& panels,
+                       const std::vector<nlohmann::json>& entries, const fs::path& file,
+                       Figures& figures) {
   Series per_episode{.label = "episode score", .points = true};
-  Series cumulative{.label = "union of touches so far"};
-  std::set<int> right, left;
+  const auto& lists = panels.geom_lists;
+  Series cumulative{.label = lists ? lists->union_label : ""};
+  std::vector<std::set<int>> seen(lists ? lists->keys.size() : 0);
   for (size_t i = 0; i < entries.size(); ++i) {
     const nlohmann::json& e = entries[i];
     if (!e.contains("score")) continue;
     per_episode.x.push_back(static_cast<double>(i));
     per_episode.y.push_back(e["score"].get<double>());
-    if (behavior == Behavior::kSelfTouch) {
-      for (int g : e.value("right_hand_touches", std::vector<int>{})) right.insert(g);
-      for (int g : e.value("left_hand_touches", std::vector<int>{})) left.insert(g);
+    if (lists) {
+      size_t count = 0;
+      for (size_t k = 0; k < seen.size(); ++k) {
+        for (int g : e.value(lists->keys[k], std::vector<int>{})) seen[k].insert(g);
+        count += seen[k].size();
+      }
       cumulative.x.push_back(static_cast<double>(i));
-      cumulative.y.push_back(static_cast<double>(right.size() + left.size()) /
-                             kSelfTouchDenominator);
+      cumulative.y.push_back(static_cast<double>(count) / lists->union_denominator);
     }
   }
   LinePlot plot{.title = "Training log: score per episode",
@@ -61,19 +63,20 @@ void plot_training_log(Behavior behavior, const std::vector<nlohmann::json>& ent
   figures.add(plot, file);
 }
 
-// Self-touch coverage per body part: fraction of each MIMo body's geoms touched by each hand over
-// the evaluation episodes.
-void plot_coverage(const mjModel* m, const std::vector<EpisodeResult>& episodes,
+// Coverage per body part: the fraction of each MIMo body's geoms in each of the task's geom lists
+// (self-touch: touched by each hand) over the evaluation episodes.
+void plot_coverage(const mjModel* m, const envs::EvaluationPanels::GeomLists& lists,
+                   const std::vector<std::vector<std::set<int>>>& episode_lists,
                    const fs::path& file, Figures& figures) {
-  BarChart chart{.title = "Self-touch coverage per body part (evaluation)",
+  BarChart chart{.title = lists.title,
                  .y_label = "fraction of geoms touched",
-                 .group_labels = {"right hand", "left hand"},
-                 .values = {{}, {}},
+                 .group_labels = lists.labels,
+                 .values = std::vector<std::vector<double>>(lists.keys.size()),
                  .y_range = std::make_pair(0.0, 1.0)};
-  std::set<int> touched[2];
-  for (const EpisodeResult& e : episodes) {
-    touched[0].insert(e.right_hand_touches.begin(), e.right_hand_touches.end());
-    touched[1].insert(e.left_hand_touches.begin(), e.left_hand_touches.end());
+  std::vector<std::set<int>> touched(lists.keys.size());
+  for (const auto& episode : episode_lists) {
+    for (size_t k = 0; k < touched.size(); ++k)
+      touched[k].insert(episode[k].begin(), episode[k].end());
   }
   for (int body = 0; body < m->nbody; ++body) {
     const int first = m->body_geomadr[body], count = m->body_geomnum[body];
@@ -87,40 +90,40 @@ void plot_coverage(const mjModel* m, const std::vector<EpisodeResult>& episodes,
     }
     if (!mimo) continue;
     chart.categories.emplace_back(name);
-    for (int hand = 0; hand < 2; ++hand) {
+    for (size_t k = 0; k < touched.size(); ++k) {
       int hit = 0;
-      for (int g = first; g < first + count; ++g) hit += static_cast<int>(touched[hand].count(g));
-      chart.values[hand].push_back(static_cast<double>(hit) / count);
+      for (int g = first; g < first + count; ++g) hit += static_cast<int>(touched[k].count(g));
+      chart.values[k].push_back(static_cast<double>(hit) / count);
     }
   }
   figures.add(chart, file, 1200, 600);
 }
 
-// Gaze-hand angle over one episode for the four eye-hand pairs, with the threshold.
-void plot_gaze(const std::vector<double>& angles, double half_angle, const fs::path& file,
-               Figures& figures) {
-  const char* labels[4] = {"right eye - right hand", "right eye - left hand",
-                           "left eye - right hand", "left eye - left hand"};
-  LinePlot plot{.title = "Gaze-hand angle (evaluation episode 0)",
-                .x_label = "step",
-                .y_label = "angle (°)",
-                .y_range = std::make_pair(0.0, 180.0),
-                .h_lines = {{half_angle, "central field of view"}}};
-  for (int k = 0; k < 4; ++k) {
-    Series s{.label = labels[k]};
-    for (size_t t = 0; 4 * t + k < angles.size(); ++t) s.y.push_back(angles[4 * t + k]);
+// The task's per-step trace over one episode, one line per value, with its threshold.
+void plot_trace(const envs::EvaluationPanels::Trace& trace, const std::vector<double>& values,
+                const fs::path& file, Figures& figures) {
+  LinePlot plot{
+      .title = trace.title, .x_label = "step", .y_label = trace.y_label, .y_range = trace.y_range};
+  if (trace.threshold) plot.h_lines.push_back(*trace.threshold);
+  const size_t width = trace.labels.size();
+  for (size_t k = 0; k < width; ++k) {
+    Series s{.label = trace.labels[k]};
+    for (size_t t = 0; width * t + k < values.size(); ++t) s.y.push_back(values[width * t + k]);
     plot.series.push_back(std::move(s));
   }
   figures.add(plot, file);
 }
 
-void write_trajectory(const Trajectory& traj, int steps, int nq, int nu, const fs::path& file) {
+void write_trajectory(const Trajectory& traj, int steps, int nq, int nu,
+                      const envs::EvaluationPanels& panels, const fs::path& file) {
   NpzWriter npz(file);
   const auto n = static_cast<std::size_t>(steps);
   npz.add("qpos", traj.qpos, {n, static_cast<std::size_t>(nq)});
   npz.add("action", traj.actions, {n, static_cast<std::size_t>(nu)});
   npz.add_strings("info", traj.infos);
-  if (!traj.gaze_angles.empty()) npz.add("gaze_angle", traj.gaze_angles, {n, 4});
+  if (panels.trace && !traj.trace.empty()) {
+    npz.add(panels.trace->key, traj.trace, {n, panels.trace->labels.size()});
+  }
   npz.close();
 }
 
@@ -161,7 +164,10 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
       report.training_hand_regard = hand_regard_score(log);
   }
   const Policy policy = given_policy ? given_policy : random_policy(options.seed ^ 0x5eedULL);
-  const auto* hand_regard = dynamic_cast<const envs::HandRegard*>(&env.task());
+  // What the task shows: its video panels, per-step trace and geom-list charts.
+  const envs::EvaluationPanels panels = env.task().evaluation_panels();
+  std::vector<double> trace_step(panels.trace ? panels.trace->labels.size() : 0);
+  std::vector<std::vector<std::set<int>>> episode_lists;  // per episode, per geom-list key
 
   std::error_code ec;
   for (const char* sub : {"trajectories", "videos", "plots"}) fs::create_directories(dir / sub, ec);
@@ -175,7 +181,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   const double fps = options.video_fps > 0 ? options.video_fps : 1.0 / step_seconds;
 
   std::vector<double> action(env.action_space().size());
-  std::vector<double> first_gaze;
+  std::vector<double> first_trace;
   for (int i = 0; i < options.episodes; ++i) {
     const auto start = std::chrono::steady_clock::now();
     env.reset(options.seed + static_cast<std::uint64_t>(i));
@@ -192,12 +198,9 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
       traj.qpos.insert(traj.qpos.end(), env.data()->qpos, env.data()->qpos + m->nq);
       traj.actions.insert(traj.actions.end(), action.begin(), action.end());
       traj.infos.push_back(env.info().to_json().dump());
-      if (hand_regard) {
-        for (int eye = 0; eye < 2; ++eye) {
-          for (int hand = 0; hand < 2; ++hand) {
-            traj.gaze_angles.push_back(hand_regard->gaze_angle(env.data(), eye, hand));
-          }
-        }
+      if (panels.trace) {
+        env.task().trace(env.data(), trace_step);
+        traj.trace.insert(traj.trace.end(), trace_step.begin(), trace_step.end());
       }
       if (video) {
         composer->compose(env, frame);
@@ -205,9 +208,9 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
       }
     }
     if (video) video->close();
-    write_trajectory(traj, options.duration, m->nq, static_cast<int>(action.size()),
+    write_trajectory(traj, options.duration, m->nq, static_cast<int>(action.size()), panels,
                      dir / "trajectories" / ("episode_" + std::to_string(i) + ".npz"));
-    if (i == 0) first_gaze = traj.gaze_angles;
+    if (i == 0) first_trace = traj.trace;
 
     EpisodeResult result;
     result.steps = options.duration;
@@ -219,7 +222,15 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
     if (const int k = info.find("left_hand_touches"); k >= 0) {
       result.left_hand_touches.assign(info.list(k).begin(), info.list(k).end());
     }
-    if (hand_regard) {
+    if (panels.geom_lists) {
+      auto& lists = episode_lists.emplace_back();
+      for (const std::string& key : panels.geom_lists->keys) {
+        const int k = info.find(key);
+        lists.emplace_back();
+        if (k >= 0) lists.back().insert(info.list(k).begin(), info.list(k).end());
+      }
+    }
+    if (config.behavior == Behavior::kHandRegard) {
       nlohmann::json entry = info.to_json();
       entry["steps"] = options.duration;
       result.hand_regard = hand_regard_episode_score(entry);
@@ -243,12 +254,12 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   // Plots (matplotlib, from plots/figures.json).
   Figures figures;
   const fs::path plots = dir / "plots";
-  if (!log.empty()) plot_training_log(config.behavior, log, plots / "training_score.png", figures);
-  if (config.behavior == Behavior::kSelfTouch) {
-    plot_coverage(m, report.episodes, plots / "touch_coverage.png", figures);
+  if (!log.empty()) plot_training_log(panels, log, plots / "training_score.png", figures);
+  if (panels.geom_lists) {
+    plot_coverage(m, *panels.geom_lists, episode_lists, plots / panels.geom_lists->file, figures);
   }
-  if (hand_regard) {
-    plot_gaze(first_gaze, config.hand_regard_half_angle, plots / "gaze_hand_angle.png", figures);
+  if (panels.trace) {
+    plot_trace(*panels.trace, first_trace, plots / panels.trace->file, figures);
   }
   if (!figures.empty()) figures.draw(plots / "figures.json");
 

@@ -11,7 +11,6 @@
 #include <utility>
 
 #include "core/error.h"
-#include "envs/self_touch.h"
 
 // Differences from the reference, on purpose:
 // - Panels render straight at 240x240 where the reference renders 480x480 and keeps every second
@@ -86,19 +85,6 @@ int camera(const mjModel* m, const char* name) {
   return id;
 }
 
-// The reference's panels per behaviour: up, down.
-std::pair<Panel, Panel> panels_for(Behavior behavior) {
-  switch (behavior) {
-    case Behavior::kSelfTouch:
-      return {Panel::kTouches, Panel::kTop};
-    case Behavior::kHandRegard:
-      return {Panel::kBinocular, Panel::kTop};
-    case Behavior::kNone:
-      break;
-  }
-  return {Panel::kSide2, Panel::kTop};
-}
-
 // The reference's grey (0.2989 R + 0.5870 G + 0.1140 B in float64, truncated by astype(uint8)).
 std::uint8_t gray(const std::uint8_t* rgb) {
   return static_cast<std::uint8_t>(0.2989 * rgb[0] + 0.5870 * rgb[1] + 0.1140 * rgb[2]);
@@ -118,7 +104,10 @@ FrameComposer::FrameComposer(const envs::BabyBenchEnv& env, senses::RenderQualit
       panel_(static_cast<size_t>(kPanel) * kPanel * 3),
       canvas_(static_cast<size_t>(kPanel) * kPanel * 3) {
   const mjModel* m = env.model();
-  std::tie(up_, down_) = panels_for(env.config().behavior);
+  // The task's panels (the reference's per behaviour).
+  const envs::EvaluationPanels panels = env.task().evaluation_panels();
+  up_ = panels.up;
+  down_ = panels.down;
   if (up_ == Panel::kBinocular) {
     eye_left_cam_ = camera(m, "eye_left");
     eye_right_cam_ = camera(m, "eye_right");
@@ -127,13 +116,13 @@ FrameComposer::FrameComposer(const envs::BabyBenchEnv& env, senses::RenderQualit
   }
   if (up_ == Panel::kTouches) {
     if (hip_body_ < 0) throw UserError("video: the model has no body named hip");
-    if (const auto* task = dynamic_cast<const envs::SelfTouch*>(&env.task())) {
+    if (!panels.mimo_geoms.empty()) {
       is_hand_.assign(m->ngeom, 0);
       is_mimo_.assign(m->ngeom, 0);
-      for (int hand = 0; hand < 2; ++hand) {
-        for (int g : task->hand_geoms(hand)) is_hand_[g] = 1;
+      for (const std::vector<int>& hand : panels.hand_geoms) {
+        for (int g : hand) is_hand_[g] = 1;
       }
-      for (int g : task->mimo_geoms()) is_mimo_[g] = 1;
+      for (int g : panels.mimo_geoms) is_mimo_[g] = 1;
     }
     const size_t n = touch_key_ >= 0 ? env.touch()->sensor_count() : m->ngeom;
     sensor_col_.resize(n);

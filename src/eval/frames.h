@@ -1,7 +1,8 @@
 // Evaluation video frames in the reference's layout (babybench/utils.py, evaluation_img): a
 // 480x480 `corner` view on the left and two 240x240 panels stacked on the right, chosen by the
-// behaviour. Panels are a camera (`side2`, `top`), the binocular anaglyph of the eye cameras, or
-// the self-touch map (MIMo's skin seen from above, active sensors in red, hand contacts in yellow).
+// task (envs::Task::evaluation_panels). Panels are a camera (`side2`, `top`), the binocular
+// anaglyph of the eye cameras, or the self-touch map (MIMo's skin seen from above, active sensors
+// in red, hand contacts in yellow).
 #pragma once
 
 #include <cstdint>
@@ -19,8 +20,8 @@ class FrameComposer {
   static constexpr int kCorner = 480;  // edge of the corner view (the reference's render_size)
   static constexpr int kPanel = 240;   // edge of each right-column panel
 
-  // What a right-column panel shows.
-  enum class Panel { kSide2, kTop, kBinocular, kTouches };
+  // What a right-column panel shows (the task says which, Task::evaluation_panels).
+  using Panel = envs::EvaluationPanels::View;
 
   // Looks up the cameras the behaviour's panels need (UserError when the model lacks one) and
   // builds a renderer. Holds no reference to env. The default quality is the model's own, what a
@@ -54,7 +55,7 @@ class FrameComposer {
   int corner_cam_, side2_cam_, top_cam_, eye_left_cam_ = -1, eye_right_cam_ = -1;
   int hip_body_;
   int touch_key_;                        // index of the touch observation (-1 without touch)
-  std::vector<char> is_hand_, is_mimo_;  // per geom, from the self-touch task (empty otherwise)
+  std::vector<char> is_hand_, is_mimo_;  // per geom, from the task's panels (empty: none)
   senses::RenderQuality quality_;
   senses::CameraRenderer renderer_;
   // Preallocated buffers: corner view, one panel, the two eye images, the touch map's float

@@ -44,6 +44,14 @@ py::dict info_dict(const envs::Info& info);
 py::tuple box_tuple(const Box& box);
 py::list space_list(const DictSpace& space);
 
+// Runs `work` with the GIL released (C++ that trains, evaluates or builds envs and touches no
+// Python object) and returns its result.
+template <typename Work>
+auto without_gil(Work&& work) {
+  py::gil_scoped_release release;
+  return work();
+}
+
 // Parses a config from YAML text (dicts arrive as JSON, a YAML subset); UserError -> ValueError.
 Config config_from_text(const std::string& text, const std::string& source);
 

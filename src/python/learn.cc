@@ -381,11 +381,7 @@ void bind_learn(py::module_& m) {
         auto hook = std::make_shared<PyRewardHook>(std::move(py_terms));
         o.reward_hook = [hook](const learn::VecEnv& env, std::span<const double> actions,
                                std::span<double> rewards) { (*hook)(env, actions, rewards); };
-        train::TrainResult r;
-        {
-          py::gil_scoped_release release;
-          r = train::train(config, o);
-        }
+        const train::TrainResult r = without_gil([&] { return train::train(config, o); });
         py::dict out;
         out["steps"] = r.steps;
         out["seconds"] = r.seconds;
@@ -410,9 +406,7 @@ void bind_learn(py::module_& m) {
   m.def(
       "load_policy",
       [](const Config& config, const std::string& checkpoint) {
-        py::gil_scoped_release release;
-        PyPolicy p{train::load_policy(config, checkpoint)};
-        return p;
+        return PyPolicy{without_gil([&] { return train::load_policy(config, checkpoint); })};
       },
       py::arg("config"), py::arg("checkpoint"));
 
@@ -430,17 +424,12 @@ void bind_learn(py::module_& m) {
         if (py::isinstance<PyPolicy>(policy)) {
           p = policy.cast<const PyPolicy&>().policy;
         } else if (py::isinstance<py::str>(policy)) {
-          py::gil_scoped_release release;
-          p = train::load_policy(config, policy.cast<std::string>());
+          const std::string checkpoint = policy.cast<std::string>();  // with the GIL
+          p = without_gil([&] { return train::load_policy(config, checkpoint); });
         } else if (!policy.is_none()) {
           p = python_policy(policy);
         }
-        eval::EvaluationReport report;
-        {
-          py::gil_scoped_release release;
-          report = eval::evaluate(config, o, p);
-        }
-        return report.to_json().dump();
+        return without_gil([&] { return eval::evaluate(config, o, p); }).to_json().dump();
       },
       py::arg("config"), py::arg("episodes"), py::arg("duration"), py::arg("render"),
       py::arg("seed"), py::arg("video_extension"), py::arg("quiet"), py::arg("policy"),

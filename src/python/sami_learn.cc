@@ -22,11 +22,7 @@ void bind_sami_learn(py::module_& m) {
                                   .resume = resume,
                                   .checkpoint_every = checkpoint_every,
                                   .progress_bar = progress_bar};
-        train::SamiTrainResult r;
-        {
-          py::gil_scoped_release release;
-          r = train::sami_train(o);
-        }
+        const train::SamiTrainResult r = without_gil([&] { return train::sami_train(o); });
         py::dict d;
         d["run"] = r.run.string();
         d["steps"] = r.steps;
@@ -44,12 +40,10 @@ void bind_sami_learn(py::module_& m) {
       "sami_evaluate",
       [](const std::string& run, const std::string& split, int episodes, bool video,
          std::uint64_t seed) {
-        train::SamiEvalResult r;
-        {
-          py::gil_scoped_release release;
-          r = train::sami_evaluate(
+        const train::SamiEvalResult r = without_gil([&] {
+          return train::sami_evaluate(
               {.run = run, .split = split, .episodes = episodes, .video = video, .seed = seed});
-        }
+        });
         py::list cells;
         for (const train::SamiCell& c : r.cells) {
           py::dict d;

@@ -24,6 +24,7 @@
 #include "learn/vector_env.h"
 #include "train/babybench_vector.h"
 #include "train/curriculum_env.h"
+#include "train/loop.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -56,24 +57,9 @@ const char* const kColumns[] = {"global_step",
                                 "perf/collect_seconds",
                                 "perf/update_seconds"};
 
-std::string cell(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 double loss(const TrainStats& s, const char* name) {
   const auto it = s.losses.find(name);
   return it == s.losses.end() ? std::nan("") : it->second;
-}
-
-std::string duration_text(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
-  const long s = static_cast<long>(seconds);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-  return buf;
 }
 
 // Learning curves from progress.csv's rows (matplotlib).
@@ -313,9 +299,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   for (auto& row : rows) row.resize(std::size(kColumns), std::nan(""));
 
   const auto start = Clock::now();
-  long next_checkpoint =
-      (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
   const long first_step = learner->steps();
+  const ProgressBar bar(options.steps, first_step, options.progress_bar && rank == 0);
   double last_score = std::nan("");
   // Stopping (Ctrl-C) is agreed by every rank of a data-parallel run.
   bool stopped = false;
@@ -354,40 +339,29 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                loss(s, "qf1_values"),
                                loss(s, "collect_seconds"),
                                loss(s, "update_seconds")};
-    for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << cell(row[c]);
+    for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << csv_cell(row[c]);
     csv << "\n";
     csv.flush();
     if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
 
-    if (options.progress_bar && rank == 0) {
-      const double done = static_cast<double>(s.steps) / options.steps;
-      const double rate = (s.steps - first_step) / std::max(elapsed, 1e-9);
-      const int width = 30;
-      const int filled = static_cast<int>(std::min(1.0, done) * width);
-      std::fprintf(stderr, "\r[%s%s] %ld/%ld steps  %.0f steps/s  ETA %s  return %s  score %s ",
-                   std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                   s.steps, options.steps, rate,
-                   duration_text((options.steps - s.steps) / std::max(rate, 1e-9)).c_str(),
-                   cell(s.episodic_return).c_str(), cell(last_score).c_str());
-      std::fflush(stderr);
-    }
-    // Learning stops at each checkpoint (saved below) and continues in a new learn() call.
-    return s.steps < next_checkpoint && !stopping();
+    bar.show(s.steps, elapsed,
+             "return " + csv_cell(s.episodic_return) + "  score " + csv_cell(last_score));
+    return true;
   };
-  // One learn() call per checkpoint interval.
-  while (learner->steps() < options.steps && !stopping()) {
-    const long before = learner->steps();
-    learner->learn(options.steps, on_progress);
-    if (learner->steps() >= next_checkpoint && learner->steps() < options.steps) {
-      save_checkpoint(
-          {checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"), latest});
-      next_checkpoint =
-          (learner->steps() / options.checkpoint_every + 1) * options.checkpoint_every;
-    }
-    if (learner->steps() == before) break;  // a learner that cannot advance
-  }
-  if (options.progress_bar && rank == 0) std::fprintf(stderr, "\n");
+  // Learning stops at each checkpoint (an episode boundary) and continues in a new learn() call.
+  const long next_checkpoint = run_loop(
+      *learner,
+      {.total_steps = options.steps,
+       .boundary_every = options.checkpoint_every,
+       .report = on_progress,
+       .at_boundary =
+           [&] {
+             save_checkpoint(
+                 {checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"), latest});
+           },
+       .stopping = stopping});
+  bar.finish();
 
   TrainResult result;
   result.steps = learner->steps();

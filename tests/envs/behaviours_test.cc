@@ -229,5 +229,50 @@ TEST(HandRegard, OccludedHandNotCountedWithOcclusionOn) {
   mj_deleteData(d);
 }
 
+// The tasks' evaluation panels: what eval/ draws for each without knowing the task.
+TEST(EvaluationPanels, SelfTouchShowsTheSkinMapAndItsTouchLists) {
+  const auto m = compile(Behavior::kSelfTouch, SceneKind::kBase);
+  SelfTouch task(m.get());
+  const EvaluationPanels panels = task.evaluation_panels();
+  EXPECT_EQ(panels.up, EvaluationPanels::View::kTouches);
+  EXPECT_EQ(panels.down, EvaluationPanels::View::kTop);
+  EXPECT_EQ(panels.hand_geoms[0], task.hand_geoms(0));
+  EXPECT_EQ(panels.hand_geoms[1], task.hand_geoms(1));
+  EXPECT_EQ(panels.mimo_geoms, task.mimo_geoms());
+  ASSERT_TRUE(panels.geom_lists);
+  // The listed keys are the ones the task declares, and the union is scored out of 68.
+  Info info;
+  task.declare(info);
+  for (const std::string& key : panels.geom_lists->keys) EXPECT_GE(info.find(key), 0) << key;
+  EXPECT_EQ(panels.geom_lists->labels.size(), panels.geom_lists->keys.size());
+  EXPECT_EQ(panels.geom_lists->union_denominator, 68);
+  EXPECT_FALSE(panels.trace);
+}
+
+TEST(EvaluationPanels, HandRegardTracesTheFourGazeAnglesAgainstItsHalfAngle) {
+  const auto m = compile(Behavior::kHandRegard, SceneKind::kCubes);
+  mjData* d = mj_makeData(m.get());
+  mj_forward(m.get(), d);
+  HandRegard task(m.get(), 12.5, false);
+  const EvaluationPanels panels = task.evaluation_panels();
+  EXPECT_EQ(panels.up, EvaluationPanels::View::kBinocular);
+  EXPECT_FALSE(panels.geom_lists);
+  ASSERT_TRUE(panels.trace);
+  ASSERT_EQ(panels.trace->labels.size(), 4u);
+  ASSERT_TRUE(panels.trace->threshold);
+  EXPECT_EQ(panels.trace->threshold->first, 12.5);
+  std::vector<double> values(4);
+  task.trace(d, values);
+  // Eye-major, as the labels: right eye (right, left hand), then left eye.
+  for (int eye = 0; eye < 2; ++eye) {
+    for (int hand = 0; hand < 2; ++hand) {
+      EXPECT_EQ(values[2 * eye + hand], task.gaze_angle(d, eye, hand));
+      EXPECT_GE(values[2 * eye + hand], 0);
+      EXPECT_LE(values[2 * eye + hand], 180);
+    }
+  }
+  mj_deleteData(d);
+}
+
 }  // namespace
 }  // namespace cradle::envs

@@ -1,0 +1,228 @@
+// What PPO and A2C share (SB3's OnPolicyAlgorithm): the settings parse, the networks, the rollout
+// collector, GAE, the learning-rate schedule, the progress report, acting and checkpoints. Each
+// algorithm's file holds its optimiser and its update, the part the papers are about. The whole
+// loop is in this one header, so that PPO reads top to bottom in ppo.h, ppo.cc and this file
+// (the collector and GAE behind it are rollout.h's, shared with the off-policy learners).
+//
+// The loop:
+//   for each iteration until the step budget is spent:
+//     (optionally) anneal the learning rate linearly to 0
+//     collect n_steps x num_envs transitions with the current Gaussian policy
+//     compute advantages A and value targets R by GAE(gamma, lambda)
+//     the algorithm's update on the rollout
+//     every report_every iterations (and at the end): report the updates' mean losses, the
+//     episodes that ended and the speed
+#pragma once
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "learn/checkpoint.h"
+#include "learn/grad_sync.h"
+#include "learn/hyperparams.h"
+#include "learn/learner.h"
+#include "learn/networks.h"
+#include "learn/preprocess.h"
+#include "learn/rollout.h"
+
+namespace cradle::learn {
+
+// Every setting of an on-policy learner: the algorithm's own (`Own`, with a bind(table)), the
+// observation's and the policy network's.
+template <typename Own>
+struct OnPolicySettings {
+  Own own;
+  ObservationConfig observation;
+  PolicyConfig policy;
+  std::string text;  // every value, "name = value" lines
+};
+
+// Binds every setting, applies the overrides strictly (UserError for an unknown name or a bad
+// value); the algorithm checks its own values after.
+template <typename Own>
+OnPolicySettings<Own> parse_on_policy_settings(const LearnerOptions& options) {
+  apply_torch_options(options);
+  OnPolicySettings<Own> settings;
+  Hyperparameters table;
+  settings.own.bind(table);
+  settings.observation.bind(table);
+  settings.policy.bind(table);
+  table.apply(options.hyperparameters);
+  settings.text = table.to_text();
+  return settings;
+}
+
+// The loop's settings, from the algorithm's config.
+struct OnPolicyLoop {
+  double learning_rate = 3e-4;
+  bool anneal_lr = false;  // decay the learning rate linearly to 0 over learn()'s total_steps
+  int n_steps = 2048;      // vector steps per env per rollout
+  double gamma = 0.99, gae_lambda = 0.95;
+  long report_every = 1;  // rollouts (and updates) per progress report
+};
+
+// Standardised advantages: (A - mean) / (std + 1e-8).
+inline torch::Tensor standardize(const torch::Tensor& advantages) {
+  return (advantages - advantages.mean()) / (advantages.std() + 1e-8);
+}
+
+// The learner skeleton. An algorithm builds its optimiser on parameters() in its constructor,
+// hands it to use_optimizer(), and implements update().
+class OnPolicyLearner : public Learner {
+ public:
+  std::string_view algorithm() const override { return algorithm_; }
+  long steps() const override { return steps_; }
+  std::string config_text() const override { return text_; }
+
+  void learn(long total_steps, const ProgressFn& on_progress) override {
+    using Clock = std::chrono::steady_clock;
+    const auto seconds = [](Clock::time_point from, Clock::time_point to) {
+      return std::chrono::duration<double>(to - from).count();
+    };
+    const Clock::time_point start = Clock::now();
+    const long start_steps = steps_;
+    collector_.start(draw_env_seed(generator_));
+    long iteration = 0;
+    std::map<std::string, double> sums;              // of the updates since the last report
+    double collect_seconds = 0, update_seconds = 0;  // since the last report
+    while (steps_ < total_steps) {
+      // Learning rate for this iteration: constant, or annealed linearly to 0.
+      double learning_rate = loop_.learning_rate;
+      if (loop_.anneal_lr) {
+        learning_rate *= 1.0 - static_cast<double>(steps_) / static_cast<double>(total_steps);
+      }
+      for (auto& group : optimizer_->param_groups()) group.options().set_lr(learning_rate);
+
+      // Collect a rollout with the current policy, then GAE advantages and value targets.
+      const Clock::time_point collect_start = Clock::now();
+      collector_.collect(policy_, generator_, buffer_);
+      steps_ += static_cast<long>(buffer_.rows()) * world_size(sync_.get());  // every rank's
+      pipeline_.merge_statistics(sync_.get());
+      buffer_.compute_returns_and_advantages(loop_.gamma, loop_.gae_lambda);
+
+      // The algorithm's update on it.
+      const Clock::time_point update_start = Clock::now();
+      {
+        const ScopedTorchThreads threads(update_threads_);
+        for (const auto& [name, value] : update()) {
+          if (auto [it, first] = sums.try_emplace(name, value); !first) it->second += value;
+        }
+      }
+      collect_seconds += seconds(collect_start, update_start);
+      update_seconds += seconds(update_start, Clock::now());
+      ++iteration;
+
+      // Report: the mean of each loss over the updates since the last report.
+      if (iteration % loop_.report_every != 0 && steps_ < total_steps) continue;
+      TrainStats stats{.steps = steps_};
+      const double updates = static_cast<double>((iteration - 1) % loop_.report_every + 1);
+      for (const auto& [name, value] : sums) stats.losses[name] = value / updates;
+      sums.clear();
+      stats.losses["learning_rate"] = learning_rate;
+      stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
+      stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
+      const EpisodeStats::Summary episodes = collector_.episodes().take();
+      stats.episodes = episodes.episodes;
+      stats.episodic_return = episodes.mean_return;
+      stats.episodic_length = episodes.mean_length;
+      stats.sps =
+          static_cast<double>(steps_ - start_steps) / std::max(seconds(start, Clock::now()), 1e-9);
+      if (on_progress && !on_progress(stats)) break;
+    }
+  }
+
+  void save(const std::filesystem::path& file) const override {
+    save_policy_checkpoint(file, {.algorithm = algorithm_, .config = text_, .steps = steps_},
+                           *policy_, *optimizer_, pipeline_, generator_);
+  }
+
+  void load(const std::filesystem::path& file) override {
+    steps_ = load_policy_checkpoint(file, algorithm_, observation_, *policy_, *optimizer_,
+                                    pipeline_, generator_)
+                 .steps;
+    offset_generator(sync_.get(), generator_);
+  }
+
+  std::uint64_t parameter_hash() const override { return tensor_hash({parameters_.tensor()}); }
+
+  void act(const envs::ObservationBuffers& observation, std::span<double> action,
+           bool deterministic) override {
+    act_gaussian(pipeline_, policy_, generator_, env_.action_space(), observation, scratch_, action,
+                 deterministic);
+  }
+
+ protected:
+  OnPolicyLearner(std::string algorithm, VecEnv& env, const LearnerOptions& options,
+                  const OnPolicyLoop& loop, const ObservationConfig& observation,
+                  const PolicyConfig& policy, std::string text)
+      : algorithm_(std::move(algorithm)),
+        text_(std::move(text)),
+        loop_(loop),
+        observation_(observation),
+        env_(env),
+        generator_(at::make_generator<at::CPUGeneratorImpl>(options.seed)),
+        pipeline_(env.observation_space(), observation, find_touch(env)),
+        policy_(pipeline_.shape(), env.action_space().size(), policy, generator_),
+        parameters_(*policy_),
+        buffer_(loop.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
+        collector_(env, pipeline_, options.reward_hook),
+        scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
+        update_threads_(update_threads(options, pipeline_.shape())),
+        sync_(options.sync) {
+    // Data-parallel: every rank starts from rank 0's parameters.
+    broadcast_tensor(sync_.get(), parameters_.tensor());
+  }
+
+  // The update on the rollout in buffer() (advantages and returns computed); returns its losses
+  // and diagnostics by name (TrainStats::losses).
+  virtual std::map<std::string, double> update() = 0;
+
+  // One optimiser step on `loss` (undefined: a zero gradient, for a data-parallel rank with no
+  // transition), the gradient averaged over the ranks and its norm clipped to max_grad_norm.
+  void gradient_step(const torch::Tensor& loss, double max_grad_norm) {
+    parameters_.zero_grad();
+    if (loss.defined()) loss.backward();
+    average_gradients(sync_.get(), parameters_.tensor().grad());
+    torch::nn::utils::clip_grad_norm_(parameters_.tensor(), max_grad_norm);
+    optimizer_->step();
+  }
+
+  // The optimiser the algorithm built on parameters() (it must outlive the learn() calls): its
+  // learning rate follows the schedule, and checkpoints hold its state.
+  void use_optimizer(torch::optim::Optimizer& optimizer) { optimizer_ = &optimizer; }
+  RolloutBuffer& buffer() { return buffer_; }
+  GaussianActorCritic& policy() { return policy_; }
+  PackedParameters& parameters() { return parameters_; }
+  at::Generator& generator() { return generator_; }
+  // The data-parallel ranks (null: alone).
+  GradSync* sync() const { return sync_.get(); }
+
+ private:
+  const std::string algorithm_;
+  const std::string text_;  // every value, "name = value" lines
+  const OnPolicyLoop loop_;
+  const ObservationConfig observation_;
+  VecEnv& env_;
+  at::Generator generator_;
+  ObservationPipeline pipeline_;
+  GaussianActorCritic policy_;
+  PackedParameters parameters_;                   // policy_'s parameters, packed for the optimiser
+  torch::optim::Optimizer* optimizer_ = nullptr;  // the algorithm's, on parameters_
+  RolloutBuffer buffer_;
+  RolloutCollector collector_;
+  ObsBatch scratch_;  // one row, for act()
+  const int update_threads_;
+  const std::shared_ptr<GradSync> sync_;  // null: alone
+  long steps_ = 0;
+};
+
+}  // namespace cradle::learn
