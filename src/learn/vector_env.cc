@@ -36,8 +36,9 @@ void check_envs(const std::vector<std::unique_ptr<envs::Env>>& envs) {
   }
 }
 
-// How long an async waiter (an idle worker, the caller in recv) polls before sleeping: a batch
-// that is ready soon after, or a job sent soon after, then needs no futex round trip.
+// How long an idle async worker polls before sleeping: a job sent soon after then needs no futex
+// round trip. The caller never polls in recv(): the other envs keep the workers busy while it
+// sleeps, and on 2 cores its polling would take a worker's core.
 constexpr std::chrono::microseconds kAsyncSpin{50};
 
 void pause() {
@@ -316,7 +317,6 @@ void AsyncVecEnv::enqueue(std::span<const int> ids) {
 
 void AsyncVecEnv::take(int want) {
   const int n = num_envs();
-  poll([this, want] { return finished_.load(std::memory_order_acquire) >= want; });
   ids_.clear();
   {
     std::unique_lock lock(mutex_);
