@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <thread>
 #include <vector>
 
 #include "core/rng.h"
 #include "envs/babybench.h"
+#include "learn/rollout.h"
 #include "learn/vector_env.h"
 #include "train/babybench_vector.h"
 
@@ -131,6 +133,158 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
   state.counters["lockstep_bound"] = seq_sum / seq_max;
 }
 BENCHMARK(BM_VecEnvScalingSelfTouch)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The async target (issue 19 item 3), measured so that the host's drift cancels: each iteration
+// runs, back to back, three slices of the same work (`kStepsPerEnv` steps of each of N self-touch
+// envs, a separate set of envs for each) on 2 threads:
+// - ceiling: each of 2 threads steps its own N/2 envs round robin with no synchronisation at all;
+// - lock-step: ThreadedVecEnv, a barrier per vector step;
+// - async: AsyncVecEnv with batch B, the caller re-sending each batch as it comes back.
+// Counters: env steps per second of each, and async_of_ceiling, lockstep_of_ceiling (target:
+// async >= 0.95 of the ceiling).
+void BM_AsyncVecEnvSelfTouch(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
+  constexpr int kStepsPerEnv = 100;
+  const int n = static_cast<int>(state.range(0));
+  const int batch = static_cast<int>(state.range(1));
+  const Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
+  const auto assets = envs::make_assets(config);
+  const auto make_list = [&] {
+    std::vector<std::unique_ptr<envs::Env>> list;
+    for (int i = 0; i < n; ++i) {
+      list.push_back(
+          std::make_unique<envs::BabyBenchEnv>(assets, learn::ThreadedVecEnv::env_seed(0, i)));
+    }
+    return list;
+  };
+  std::vector<std::unique_ptr<envs::Env>> free_envs = make_list();
+  for (auto& env : free_envs) env->reset(0);
+  learn::ThreadedVecEnv lockstep(make_list(), 2);
+  learn::AsyncVecEnv async(make_list(), batch, 2);
+  lockstep.reset(0);
+  async.reset(0);
+  const Box& space = lockstep.action_space();
+  const size_t dim = space.low.size();
+  // Pre-drawn actions: row t holds every env's action for its t-th step of a slice.
+  Rng rng(1);
+  std::vector<std::vector<double>> actions(kStepsPerEnv, std::vector<double>(n * dim));
+  for (auto& row : actions) {
+    for (size_t j = 0; j < row.size(); ++j)
+      row[j] = rng.uniform(space.low[j % dim], space.high[j % dim]);
+  }
+  const auto seconds = [](Clock::time_point since) {
+    return std::chrono::duration<double>(Clock::now() - since).count();
+  };
+  // Thread t's share of the ceiling: envs t, t + 2, ... round robin.
+  const auto run_free = [&](int t) {
+    for (int k = 0; k < kStepsPerEnv; ++k) {
+      for (int e = t; e < n; e += 2) {
+        const envs::StepResult r = free_envs[e]->step(std::span(actions[k]).subspan(e * dim, dim));
+        if (r.terminated || r.truncated) free_envs[e]->reset();
+      }
+    }
+  };
+  std::vector<int> ids(n), steps(n);
+  std::vector<double> batch_actions(n * dim);
+  double free_time = 0, lockstep_time = 0, async_time = 0;
+  long rounds = 0, async_steps = 0;
+  for (auto _ : state) {
+    Clock::time_point start = Clock::now();
+    std::thread other([&] { run_free(1); });
+    run_free(0);
+    other.join();
+    free_time += seconds(start);
+
+    start = Clock::now();
+    for (int k = 0; k < kStepsPerEnv; ++k) lockstep.step(actions[k]);
+    lockstep_time += seconds(start);
+
+    // Every env sent, then each batch re-sent as it returns, until every env took its steps.
+    start = Clock::now();
+    for (int e = 0; e < n; ++e) ids[e] = e;
+    std::fill(steps.begin(), steps.end(), 0);
+    async.send(actions[0], ids);
+    for (int running = n; running > 0;) {
+      const learn::AsyncVecEnv::Batch b = async.recv();
+      ids.clear();
+      batch_actions.clear();
+      for (int e : b.ids) {
+        ++async_steps;
+        if (++steps[e] == kStepsPerEnv) {
+          --running;
+          continue;
+        }
+        ids.push_back(e);
+        const double* a = actions[steps[e]].data() + e * dim;
+        batch_actions.insert(batch_actions.end(), a, a + dim);
+      }
+      if (!ids.empty()) async.send(batch_actions, ids);
+    }
+    async_time += seconds(start);
+    ids.resize(n);
+    ++rounds;
+  }
+  const double work = static_cast<double>(rounds) * n * kStepsPerEnv;
+  const double ceiling = work / free_time, locked = work / lockstep_time;
+  const double async_rate = async_steps / async_time;
+  state.counters["ceiling_sps"] = ceiling;
+  state.counters["lockstep_sps"] = locked;
+  state.counters["async_sps"] = async_rate;
+  state.counters["lockstep_of_ceiling"] = locked / ceiling;
+  state.counters["async_of_ceiling"] = async_rate / ceiling;
+}
+BENCHMARK(BM_AsyncVecEnvSelfTouch)
+    ->ArgNames({"envs", "batch"})
+    ->Args({4, 2})
+    ->Args({8, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// PPO's collection on self-touch, lock-step (ThreadedVecEnv) against async (AsyncVecEnv, batch
+// envs / 2), N envs on 2 threads: one rollout of 64 steps per env with SB3's default policy (64-64
+// tanh MLPs, pooled touch, normalised observations), one LibTorch thread. items_per_second counts
+// env steps.
+void BM_PpoCollectSelfTouch(benchmark::State& state) {
+  constexpr int kSteps = 64;
+  const int n = static_cast<int>(state.range(0));
+  const bool async = state.range(1) != 0;
+  torch::set_num_threads(1);
+  const Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs" / "config_selftouch.yml");
+  const auto assets = envs::make_assets(config);
+  std::vector<std::unique_ptr<envs::Env>> list;
+  for (int i = 0; i < n; ++i) {
+    list.push_back(
+        std::make_unique<envs::BabyBenchEnv>(assets, learn::ThreadedVecEnv::env_seed(0, i)));
+  }
+  std::unique_ptr<learn::VecEnv> vec;
+  if (async) {
+    vec = std::make_unique<learn::AsyncVecEnv>(std::move(list), n / 2, 2);
+  } else {
+    vec = std::make_unique<learn::ThreadedVecEnv>(std::move(list), 2);
+  }
+  at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(0);
+  const learn::ObservationConfig observation_config;
+  learn::ObservationPipeline pipeline(vec->observation_space(), observation_config,
+                                      learn::find_touch(*vec));
+  const learn::PolicyConfig policy_config;
+  learn::GaussianActorCritic policy(pipeline.shape(), vec->action_space().size(), policy_config,
+                                    generator);
+  learn::RolloutBuffer buffer(kSteps, n, pipeline.shape(), vec->action_space().size());
+  learn::RolloutCollector collector(*vec, pipeline, nullptr);
+  collector.start(0);
+  for (auto _ : state) collector.collect(policy, generator, buffer);
+  state.SetItemsProcessed(state.iterations() * kSteps * n);
+}
+BENCHMARK(BM_PpoCollectSelfTouch)
+    ->ArgNames({"envs", "async"})
+    ->Args({4, 0})
+    ->Args({4, 1})
+    ->Args({8, 0})
+    ->Args({8, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace cradle

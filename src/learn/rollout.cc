@@ -147,21 +147,55 @@ void EnvStepper::step(std::span<const double> actions) {
 
 RolloutCollector::RolloutCollector(VecEnv& env, ObservationPipeline& pipeline,
                                    RewardHook reward_hook)
-    : env_(env), pipeline_(pipeline), stepper_(env, std::move(reward_hook)) {
+    : env_(env),
+      pipeline_(pipeline),
+      stepper_(env, reward_hook),
+      async_(dynamic_cast<AsyncVecEnv*>(&env)) {
   const int envs = env.num_envs();
   const int action_size = env.action_space().size();
   observation_ = ObsBatch::zeros(pipeline.shape(), envs);
   noise_ = torch::zeros({envs, action_size}, torch::kFloat32);
   actions_.resize(static_cast<size_t>(envs) * action_size);
+  if (!async_) return;
+  reward_hook_ = std::move(reward_hook);
+  sent_actions_.resize(static_cast<size_t>(envs) * action_size);
+  hook_actions_.resize(static_cast<size_t>(async_->batch_size()) * action_size);
+  hook_rewards_.resize(async_->batch_size());
+  all_ids_.resize(envs);
+  for (int e = 0; e < envs; ++e) all_ids_[e] = e;
+  filled_.assign(envs, 0);
+  pending_.assign(envs, 0);
+  batch_observation_ = ObsBatch::zeros(pipeline.shape(), async_->batch_size());
+  batch_noise_ = torch::zeros({async_->batch_size(), action_size}, torch::kFloat32);
+  send_ids_.reserve(async_->batch_size());
+  send_actions_.reserve(static_cast<size_t>(async_->batch_size()) * action_size);
 }
 
 void RolloutCollector::start(std::uint64_t seed) {
   stepper_.start(seed);
   pipeline_.process(env_, /*update_stats=*/true, observation_);
+  std::fill(pending_.begin(), pending_.end(), 0);
 }
+
+namespace {
+
+// Copies row `from_row` of `from` into row `to_row` of `to` (same shapes, contiguous).
+void copy_row(const ObsBatch& from, long from_row, ObsBatch& to, long to_row) {
+  const long n = from.vector.size(1);
+  std::memcpy(to.vector.data_ptr<float>() + to_row * n,
+              from.vector.data_ptr<float>() + from_row * n, sizeof(float) * n);
+  for (size_t k = 0; k < from.images.size(); ++k) {
+    const long bytes = from.images[k].numel() / from.images[k].size(0);
+    std::memcpy(to.images[k].data_ptr<std::uint8_t>() + to_row * bytes,
+                from.images[k].data_ptr<std::uint8_t>() + from_row * bytes, bytes);
+  }
+}
+
+}  // namespace
 
 void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& generator,
                                RolloutBuffer& buffer) {
+  if (async_) return collect_async(policy, generator, buffer);
   torch::NoGradGuard no_grad;
   const int envs = env_.num_envs();
   const long action_size = buffer.actions.size(1);
@@ -202,6 +236,113 @@ void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& gener
     pipeline_.process(env_, /*update_stats=*/true, observation_);
   }
   buffer.last_values.copy_(policy->value(observation_));
+}
+
+void RolloutCollector::collect_async(GaussianActorCritic& policy, at::Generator& generator,
+                                     RolloutBuffer& buffer) {
+  torch::NoGradGuard no_grad;
+  AsyncVecEnv& vec = *async_;
+  const int envs = vec.num_envs();
+  const long action_size = buffer.actions.size(1);
+  const Box& bounds = vec.action_space();
+  const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
+  float* actions_out = buffer.actions.data_ptr<float>();
+  float* log_probs_out = buffer.log_probs.data_ptr<float>();
+  float* values_out = buffer.values.data_ptr<float>();
+  float* rewards_out = buffer.rewards.data_ptr<float>();
+  std::uint8_t* terminal_out = buffer.terminated.data_ptr<std::uint8_t>();
+  std::uint8_t* done_out = buffer.dones.data_ptr<std::uint8_t>();
+  std::uint8_t* valid_out = buffer.valid.data_ptr<std::uint8_t>();
+  float* last_values_out = buffer.last_values.data_ptr<float>();
+  EpisodeStats& episodes = stepper_.episodes();
+
+  // Every env is held: the first row of each, as one lock-step batch (rows 0..envs-1), sent.
+  {
+    buffer.observations.assign(0, observation_);
+    const GaussianActorCriticImpl::Output out = policy->forward(observation_);
+    noise_.normal_(0.0, 1.0, generator);
+    const torch::Tensor actions = out.mean + torch::exp(policy->log_std()) * noise_;
+    const torch::Tensor log_probs =
+        (-0.5 * noise_.square() - policy->log_std() - half_log_2pi).sum(1);
+    std::memcpy(actions_out, actions.data_ptr<float>(), sizeof(float) * envs * action_size);
+    std::memcpy(log_probs_out, log_probs.data_ptr<float>(), sizeof(float) * envs);
+    std::memcpy(values_out, out.value.contiguous().data_ptr<float>(), sizeof(float) * envs);
+    clip_actions(actions, bounds, actions_);
+    std::copy(actions_.begin(), actions_.end(), sent_actions_.begin());
+    std::fill(filled_.begin(), filled_.end(), 1);
+    vec.send(actions_, all_ids_);
+  }
+
+  // Then batches as they come: record each env's last transition, and act again until the env
+  // has filled its rows; a full env's value is its bootstrap value and it waits, held.
+  int full = 0;
+  while (full < envs) {
+    const AsyncVecEnv::Batch batch = vec.recv();
+    const int k = batch.size();
+    const BatchView view(vec, batch);
+    // The rewards to train on: the env's plus the hook's, which sees the batch as a vector.
+    std::copy(batch.rewards.begin(), batch.rewards.end(), hook_rewards_.begin());
+    if (reward_hook_) {
+      for (int j = 0; j < k; ++j) {
+        std::copy_n(sent_actions_.data() + static_cast<size_t>(batch.ids[j]) * action_size,
+                    action_size, hook_actions_.data() + static_cast<size_t>(j) * action_size);
+      }
+      reward_hook_(view, std::span(hook_actions_).first(static_cast<size_t>(k) * action_size),
+                   std::span(hook_rewards_).first(k));
+    }
+    for (int j = 0; j < k; ++j) {
+      const int e = batch.ids[j];
+      const long row = static_cast<long>(filled_[e] - 1) * envs + e;
+      // An autoreset step is no transition (next-step autoreset, as EnvStepper tells).
+      const bool real = !pending_[e];
+      const bool ended = batch.terminated[j] || batch.truncated[j];
+      pending_[e] = real && ended;
+      if (real) {
+        episodes.add(e, hook_rewards_[j]);
+        if (ended) episodes.end(e);
+      }
+      valid_out[row] = real;
+      rewards_out[row] = real ? static_cast<float>(hook_rewards_[j]) : 0.0f;
+      terminal_out[row] = real && batch.terminated[j];
+      done_out[row] = real && ended;
+    }
+    pipeline_.process(view, /*update_stats=*/true, batch_observation_);
+    const ObsBatch observation =
+        k == batch_observation_.rows() ? batch_observation_ : batch_observation_.slice(0, k);
+    const GaussianActorCriticImpl::Output out = policy->forward(observation);
+    const torch::Tensor noise = batch_noise_.slice(0, 0, k);
+    noise.normal_(0.0, 1.0, generator);
+    const torch::Tensor actions = (out.mean + torch::exp(policy->log_std()) * noise).contiguous();
+    const torch::Tensor log_probs =
+        (-0.5 * noise.square() - policy->log_std() - half_log_2pi).sum(1).contiguous();
+    const torch::Tensor values = out.value.contiguous();
+    const float* action = actions.data_ptr<float>();
+    send_ids_.clear();
+    send_actions_.clear();
+    for (int j = 0; j < k; ++j) {
+      const int e = batch.ids[j];
+      copy_row(batch_observation_, j, observation_, e);
+      if (filled_[e] == buffer.steps) {
+        last_values_out[e] = values.data_ptr<float>()[j];
+        ++full;
+        continue;
+      }
+      const long row = static_cast<long>(filled_[e]++) * envs + e;
+      copy_row(batch_observation_, j, buffer.observations, row);
+      std::memcpy(actions_out + row * action_size, action + j * action_size,
+                  sizeof(float) * action_size);
+      log_probs_out[row] = log_probs.data_ptr<float>()[j];
+      values_out[row] = values.data_ptr<float>()[j];
+      for (long d = 0; d < action_size; ++d) {
+        const double clipped = std::clamp(static_cast<double>(action[j * action_size + d]),
+                                          bounds.low[d], bounds.high[d]);
+        sent_actions_[e * action_size + d] = clipped;
+        send_actions_.push_back(clipped);
+      }
+      send_ids_.push_back(e);
+    }
+    if (!send_ids_.empty()) vec.send(send_actions_, send_ids_);
+  }
 }
 
 void act_gaussian(ObservationPipeline& pipeline, GaussianActorCritic& policy,

@@ -22,6 +22,7 @@
 #include "learn/networks.h"
 #include "learn/preprocess.h"
 #include "learn/vec_env.h"
+#include "learn/vector_env.h"
 
 namespace cradle::learn {
 
@@ -101,6 +102,15 @@ class EnvStepper {
 };
 
 // Runs a GaussianActorCritic in a VecEnv and fills rollout buffers.
+//
+// Given an AsyncVecEnv it collects through send/recv (no lock-step): each env fills its own rows
+// (row = its step in this rollout x envs + env id, so GAE sees per-env sequences as before) at its
+// own pace; an env that has filled buffer.steps rows is held until the next rollout, and the
+// value of its observation then is its last value. Observation statistics and action noise are
+// taken in batch order, which timing decides, so such runs are not bitwise repeatable. The reward
+// hook sees each batch as a VecEnv of its own (BatchView: env j is the batch's j-th env id) with
+// the batch's actions and rewards, so a hook that keeps per-env state by position (the intrinsic
+// rewards) does not fit async collection.
 class RolloutCollector {
  public:
   RolloutCollector(VecEnv& env, ObservationPipeline& pipeline, RewardHook reward_hook);
@@ -113,12 +123,26 @@ class RolloutCollector {
   EpisodeStats& episodes() { return stepper_.episodes(); }
 
  private:
+  void collect_async(GaussianActorCritic& policy, at::Generator& generator, RolloutBuffer& buffer);
+
   VecEnv& env_;
   ObservationPipeline& pipeline_;
   EnvStepper stepper_;
   ObsBatch observation_;  // current normalised observations, one row per env
   torch::Tensor noise_;   // [envs, action_size]
   std::vector<double> actions_;
+  // Async collection: the env's async face (null in lock-step), every env id, per env its rows
+  // filled this rollout and whether its next step is an autoreset, and a batch's scratch.
+  AsyncVecEnv* async_ = nullptr;
+  std::vector<int> all_ids_, filled_;
+  std::vector<std::uint8_t> pending_;
+  ObsBatch batch_observation_;
+  torch::Tensor batch_noise_;
+  std::vector<int> send_ids_;
+  std::vector<double> send_actions_;
+  RewardHook reward_hook_;
+  std::vector<double> sent_actions_;                 // per env: its last action (clipped)
+  std::vector<double> hook_actions_, hook_rewards_;  // a batch's, for the hook
 };
 
 // Writes actions[i] = clamp(samples[i], low[i], high[i]) (doubles, row-major).
