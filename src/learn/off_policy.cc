@@ -1,8 +1,13 @@
 #include "learn/off_policy.h"
 
 #include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <functional>
+#include <mutex>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 #include "core/error.h"
@@ -22,6 +27,11 @@ void OffPolicyConfig::bind(Hyperparameters& table) {
   table.add("episode_train_freq", &episode_train_freq,
             "> 0: at each episode end, ceil(length / this) gradient steps (SpinningUp SAC)");
   table.add("report_every", &report_every, "vector steps between progress reports");
+  table.add("overlap_collection", &overlap_collection,
+            "collect on a thread of its own during the updates (stale actor; not bitwise "
+            "reproducible)");
+  table.add("actor_refresh", &actor_refresh,
+            "overlap_collection: gradient steps between refreshes of the collector's actor");
 }
 
 void OffPolicyConfig::check(std::string_view algorithm) const {
@@ -31,6 +41,7 @@ void OffPolicyConfig::check(std::string_view algorithm) const {
                     ": batch_size, train_freq, gradient_steps and report_every must be positive");
   }
   if (learning_starts < 0) throw UserError(name + ": learning_starts must be >= 0");
+  if (actor_refresh < 1) throw UserError(name + ": actor_refresh must be positive");
   if (episode_train_freq < 0) throw UserError(name + ": episode_train_freq must be >= 0");
   if (!(tau > 0 && tau <= 1)) throw UserError(name + ": tau must be in (0, 1]");
   if (!(gamma >= 0 && gamma <= 1)) throw UserError(name + ": gamma must be in [0, 1]");
@@ -48,29 +59,70 @@ void OffPolicyNetworkConfig::bind(Hyperparameters& table) {
 // Critics
 
 CriticImpl::CriticImpl(const ObsShape& shape, int action_size, int critics,
-                       const OffPolicyNetworkConfig& config, at::Generator& generator) {
-  encoder_ = register_module("encoder", MultiInputEncoder(shape, config.cnn_features));
-  const int input = encoder_->output_size() + action_size;
-  const int last = config.qf_layers.empty() ? input : config.qf_layers.back();
-  for (int i = 0; i < critics; ++i) {
-    torch::nn::Sequential q = make_mlp(input, config.qf_layers, config.activation);
-    q->push_back(torch::nn::Linear(last, 1));
-    q_.push_back(register_module("q" + std::to_string(i + 1), q));
+                       const OffPolicyNetworkConfig& config, at::Generator& generator)
+    : critics_(critics), relu_(config.activation == "relu") {
+  if (config.activation != "tanh" && config.activation != "relu") {
+    throw UserError("activation '" + config.activation + "': expected tanh or relu");
   }
-  // SB3 keeps PyTorch's default initialisation for off-policy networks. (Per child: a module
-  // under construction cannot list itself.)
-  for (const auto& child : children()) init_layers(*child, 1.0, /*orthogonal=*/false, generator);
+  encoder_ = register_module("encoder", MultiInputEncoder(shape, config.cnn_features));
+  // SB3 keeps PyTorch's default initialisation for off-policy networks.
+  init_layers(*encoder_, 1.0, /*orthogonal=*/false, generator);
+  std::vector<int> sizes{encoder_->output_size() + action_size};
+  for (const int size : config.qf_layers) {
+    if (size <= 0) throw UserError("hidden layer sizes must be positive");
+    sizes.push_back(size);
+  }
+  sizes.push_back(1);
+  for (size_t l = 0; l + 1 < sizes.size(); ++l) {
+    const std::string name = std::to_string(l);
+    weights_.push_back(
+        register_parameter("weight" + name, torch::empty({critics, sizes[l], sizes[l + 1]})));
+    biases_.push_back(register_parameter("bias" + name, torch::empty({critics, 1, sizes[l + 1]})));
+  }
+  // Uniform in +-1/sqrt(fan_in), critic by critic and layer by layer, weight then bias: the
+  // draws (and values) of n separate MLPs of Linear layers.
+  torch::NoGradGuard no_grad;
+  for (int i = 0; i < critics; ++i) {
+    for (size_t l = 0; l < weights_.size(); ++l) {
+      const double bound = 1.0 / std::sqrt(static_cast<double>(sizes[l]));
+      weights_[l][i].copy_(
+          torch::empty({sizes[l + 1], sizes[l]}).uniform_(-bound, bound, generator).t());
+      biases_[l][i][0].uniform_(-bound, bound, generator);
+    }
+  }
+}
+
+torch::Tensor CriticImpl::activate(const torch::Tensor& x) const {
+  return relu_ ? torch::relu(x) : torch::tanh(x);
 }
 
 torch::Tensor CriticImpl::forward(const ObsBatch& observation, const torch::Tensor& actions) {
   const torch::Tensor input = torch::cat({encoder_->forward(observation), actions}, 1);
-  std::vector<torch::Tensor> values;
-  for (auto& q : q_) values.push_back(q->forward(input).squeeze(1));
-  return torch::stack(values);
+  // Every critic reads the same input: broadcast over the critics, not copied.
+  torch::Tensor h = input.unsqueeze(0).expand({critics_, input.size(0), input.size(1)});
+  for (size_t l = 0; l < weights_.size(); ++l) {
+    h = torch::baddbmm(biases_[l], h, weights_[l]);
+    if (l + 1 < weights_.size()) h = activate(h);
+  }
+  return h.squeeze(2);
 }
 
 torch::Tensor CriticImpl::q1(const ObsBatch& observation, const torch::Tensor& actions) {
-  return q_[0]->forward(torch::cat({encoder_->forward(observation), actions}, 1)).squeeze(1);
+  torch::Tensor h = torch::cat({encoder_->forward(observation), actions}, 1);
+  for (size_t l = 0; l < weights_.size(); ++l) {
+    h = torch::addmm(biases_[l][0], h, weights_[l][0]);
+    if (l + 1 < weights_.size()) h = activate(h);
+  }
+  return h.squeeze(1);
+}
+
+void check_critic_format(torch::serialize::InputArchive& archive, const std::string& key) {
+  torch::serialize::InputArchive critic, legacy;
+  if (!archive.try_read(key, critic) || !critic.try_read("q1", legacy)) return;
+  throw UserError(key +
+                  " is in the format of separate critic MLPs (q1, q2, ...; Cradle before "
+                  "the fused critics), this build reads fused critics (weight<l> [n, in, out]): "
+                  "retrain, or load it with an older build");
 }
 
 void polyak_update(torch::Tensor& target, const torch::Tensor& online, double tau) {
@@ -121,6 +173,10 @@ OffPolicyLearner::OffPolicyLearner(std::string algorithm, VecEnv& env,
       sync_(options.sync) {}
 
 void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
+  if (config_.overlap_collection) {
+    learn_overlapped(total_steps, on_progress);
+    return;
+  }
   const Clock::time_point start = Clock::now();
   const long start_steps = steps_;
   const int envs = env_.num_envs();
@@ -132,8 +188,9 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   std::vector<std::uint8_t> episode_ended(envs, 0);
   // Episode-end updates differ per rank, and every update is a collective: refused together.
   if (config_.episode_train_freq > 0 && distributed(sync_.get()))
-    throw UserError("episode_train_freq > 0 cannot run distributed (ranks would update a different "
-                    "number of times); use train_freq/gradient_steps");
+    throw UserError(
+        "episode_train_freq > 0 cannot run distributed (ranks would update a different "
+        "number of times); use train_freq/gradient_steps");
   // Data-parallel: every rank continues from rank 0's networks.
   for (const auto& [key, module] : modules_) broadcast_module(sync_.get(), *module);
   for (const auto& [key, tensor] : tensors_) broadcast_tensor(sync_.get(), *tensor);
@@ -169,35 +226,193 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
         episode_ended[e] = 1;
       }
     }
-    if (updates > 0 && ready_to_train()) {
-      const ScopedTorchThreads threads(update_threads_);
-      for (int g = 0; g < updates; ++g) {
-        ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
-        pipeline_.normalize(batch.observations.vector, batch.observations.vector);
-        pipeline_.normalize(batch.next_observations.vector, batch.next_observations.vector);
-        train(batch, ++updates_);
-      }
-    }
+    if (updates > 0 && ready_to_train()) run_updates(updates, pipeline_.normalizer());
     update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();
 
     if (vector_steps_ % config_.report_every != 0 && steps_ < total_steps) continue;
-    pipeline_.merge_statistics(sync_.get());
-    TrainStats stats{.steps = steps_};
-    for (const auto& [name, record] : records_) stats.losses[name] = record.first / record.second;
-    records_.clear();
-    stats.losses["learning_rate"] = config_.learning_rate;
-    stats.losses["buffer_transitions"] = static_cast<double>(buffer_.size());
-    stats.losses["updates"] = static_cast<double>(updates_);  // gradient steps so far
-    stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
-    stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
-    const EpisodeStats::Summary episodes = collector_.episodes().take();
-    stats.episodes = episodes.episodes;
-    stats.episodic_return = episodes.mean_return;
-    stats.episodic_length = episodes.mean_length;
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
+    const TrainStats stats = report(start, start_steps, collect_seconds, update_seconds);
     if (on_progress && !on_progress(stats)) break;
   }
+}
+
+TrainStats OffPolicyLearner::report(Clock::time_point start, long start_steps,
+                                    double& collect_seconds, double& update_seconds) {
+  pipeline_.merge_statistics(sync_.get());
+  TrainStats stats{.steps = steps_};
+  for (const auto& [name, record] : records_) stats.losses[name] = record.first / record.second;
+  records_.clear();
+  stats.losses["learning_rate"] = config_.learning_rate;
+  stats.losses["buffer_transitions"] = static_cast<double>(buffer_.size());
+  stats.losses["updates"] = static_cast<double>(updates_);  // gradient steps so far
+  stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
+  stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
+  const EpisodeStats::Summary episodes = collector_.episodes().take();
+  stats.episodes = episodes.episodes;
+  stats.episodic_return = episodes.mean_return;
+  stats.episodic_length = episodes.mean_length;
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
+  return stats;
+}
+
+OffPolicyLearner::ActorCopy OffPolicyLearner::copy_actor() {
+  throw UserError(algorithm_ + ": overlap_collection is not available for this algorithm");
+}
+
+void OffPolicyLearner::learn_overlapped(long total_steps, const ProgressFn& on_progress) {
+  if (config_.episode_train_freq > 0 || distributed(sync_.get()) || !shape().images.empty()) {
+    throw UserError(algorithm_ +
+                    ": overlap_collection needs train_freq/gradient_steps (not "
+                    "episode_train_freq), one process (not --distributed) and vector "
+                    "observations (image updates use every core already)");
+  }
+  if (steps_ >= total_steps) return;
+  const Clock::time_point start = Clock::now();
+  const long start_steps = steps_;
+  const int envs = env_.num_envs();
+  collector_.start(draw_env_seed(generator_));
+  // The collector's own generator and actor copy, and its staging buffer (one cycle).
+  at::Generator collect_generator =
+      at::make_generator<at::CPUGeneratorImpl>(draw_env_seed(generator_));
+  const ActorCopy actor = copy_actor();
+  const std::vector<torch::Tensor> source = actor.source->parameters();
+  const std::vector<torch::Tensor> copy = actor.copy->parameters();
+  auto refresh = [&] {
+    torch::NoGradGuard no_grad;
+    for (size_t i = 0; i < copy.size(); ++i) copy[i].copy_(source[i]);
+  };
+  refresh();
+  ReplayBuffer staging(static_cast<long>(config_.train_freq) * envs, shape(), action_size());
+  records_.clear();
+  double collect_seconds = 0, update_seconds = 0;  // since the last report
+
+  // The handoff: the learner orders `order` vector steps (from env step `first`); the collector
+  // sets order back to 0 when they are staged (or it failed, or was told to stop).
+  struct Handoff {
+    std::mutex mutex;
+    std::condition_variable changed;
+    long order = 0, first = 0;
+    bool stop = false;
+    std::exception_ptr error;
+    double seconds = 0;  // the collector's time of the last order
+  } handoff;
+  auto collect = [&] {
+    std::unique_lock lock(handoff.mutex);
+    while (true) {
+      handoff.changed.wait(lock, [&] { return handoff.order > 0 || handoff.stop; });
+      if (handoff.stop) return;
+      const long order = handoff.order, first = handoff.first;
+      lock.unlock();
+      // Everything below is the collector's until it sets order back to 0.
+      const Clock::time_point begin = Clock::now();
+      std::exception_ptr error;
+      try {
+        torch::Tensor random = torch::zeros({envs, action_size()}, torch::kFloat32);
+        for (long k = 0; k < order; ++k) {
+          torch::Tensor actions;
+          if (first + k * envs < config_.learning_starts) {
+            actions = random.uniform_(-1.0, 1.0, collect_generator);
+          } else {
+            torch::NoGradGuard no_grad;
+            actions = actor.explore(collector_.observation(), collect_generator);
+          }
+          collector_.step(actions, staging);
+        }
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      handoff.seconds = std::chrono::duration<double>(Clock::now() - begin).count();
+      handoff.error = error;
+      handoff.order = 0;
+      handoff.changed.notify_all();
+      if (error) return;
+    }
+  };
+  std::thread collector(collect);
+  // Stops and joins the collector however learn() ends (returns, throws).
+  struct Join {
+    Handoff& handoff;
+    std::thread& thread;
+    ~Join() {
+      {
+        const std::lock_guard lock(handoff.mutex);
+        handoff.stop = true;
+      }
+      handoff.changed.notify_all();
+      thread.join();
+    }
+  } join{handoff, collector};
+  auto launch = [&](long vector_steps) {
+    const std::lock_guard lock(handoff.mutex);
+    handoff.order = vector_steps;
+    handoff.first = steps_;
+    handoff.changed.notify_all();
+  };
+  // Waits for the collector to finish its order; returns the vector steps it staged.
+  long ordered = 0;
+  auto wait = [&] {
+    std::unique_lock lock(handoff.mutex);
+    handoff.changed.wait(lock, [&] { return handoff.order == 0; });
+    if (handoff.error) std::rethrow_exception(handoff.error);
+    collect_seconds += std::exchange(handoff.seconds, 0.0);
+    return std::exchange(ordered, 0L);
+  };
+  auto order = [&] {
+    const long left = (total_steps - steps_ + envs - 1) / envs;
+    ordered = std::min<long>(config_.train_freq, left);
+    if (ordered > 0) launch(ordered);
+  };
+
+  order();
+  long refreshed = updates_;  // updates_ at the last refresh
+  RunningMeanStd statistics;  // the normaliser's at the handoff, for the learner's minibatches
+  bool report_due = false;  // by the transitions merged at the last handoff
+  while (true) {
+    // Handoff: the collector is idle and the last merge's updates are done. Report those (the
+    // synchronous loop's reports, at the same steps), then merge and count the staged ones.
+    const long staged = wait();
+    if (report_due || steps_ >= total_steps) {
+      const TrainStats stats = report(start, start_steps, collect_seconds, update_seconds);
+      if (on_progress && !on_progress(stats)) break;
+      if (steps_ >= total_steps) break;
+    }
+    buffer_.append(staging);
+    int updates = 0;
+    report_due = false;
+    for (long k = 0; k < staged; ++k) {
+      steps_ += envs;
+      ++vector_steps_;
+      if (vector_steps_ % config_.train_freq == 0) updates += config_.gradient_steps;
+      if (vector_steps_ % config_.report_every == 0) report_due = true;
+    }
+    if (updates_ - refreshed >= config_.actor_refresh) {
+      refresh();
+      refreshed = updates_;
+    }
+    statistics = pipeline_.normalizer();
+    order();
+
+    // The merged transitions' gradient steps, while the collector collects the next ones.
+    const Clock::time_point update_start = Clock::now();
+    if (updates > 0 && ready_to_train()) run_updates(updates, statistics);
+    update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();
+  }
+}
+
+void OffPolicyLearner::run_updates(int count, const RunningMeanStd& statistics) {
+  const ScopedTorchThreads threads(update_threads_);
+  for (int g = 0; g < count; ++g) {
+    ReplayBuffer::Sample batch = buffer_.sample(config_.batch_size, generator_);
+    pipeline_.normalize(batch.observations.vector, batch.observations.vector, statistics);
+    pipeline_.normalize(batch.next_observations.vector, batch.next_observations.vector, statistics);
+    train(batch, ++updates_);
+  }
+}
+
+void OffPolicyLearner::update(int count) {
+  if (buffer_.size() == 0) throw UserError(algorithm_ + ": no transitions to update on yet");
+  run_updates(count, pipeline_.normalizer());
 }
 
 bool OffPolicyLearner::ready_to_train() {
@@ -276,6 +491,7 @@ void OffPolicyLearner::load(const std::filesystem::path& file) {
         }
         std::vector<std::function<void()>> copies;
         for (const auto& [key, module] : modules_) {
+          if (module->as<CriticImpl>() != nullptr) check_critic_format(archive, key);
           copies.push_back(stage_module(archive, key, *module));
         }
         for (const auto& copy : copies) copy();

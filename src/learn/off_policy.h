@@ -10,6 +10,16 @@
 //     every train_freq vector steps, once the buffer holds more than learning_starts
 //     transitions: gradient_steps updates on minibatches of batch_size
 //   reporting every report_every vector steps.
+// With overlap_collection the two halves run at once, in cycles of train_freq vector steps:
+//   handoff (both idle): merge the collector's staged transitions into the buffer, count them,
+//     refresh the collector's actor copy (every actor_refresh updates), report and checkpoint;
+//   then, concurrently: the collector thread steps the envs train_freq vector steps with the
+//     copy (its own generator) into a staging buffer, while the learner does the gradient
+//     steps the merged ones call for (gradient_steps per train_freq vector steps, as above).
+// Everything shared (envs, normaliser, staging, copy, counters) changes hands only at the
+// handoff, under a mutex: no data race. The collector acts with an actor one cycle older than
+// the synchronous loop's (gradient_steps updates; distributed SAC's stale actors); the cycle's
+// length is max(collect, update) instead of their sum.
 // Training waits on the buffer's size rather than the step counter so that a resumed run,
 // whose buffer starts empty (it is not saved), refills it before training again; it acts
 // with its loaded policy meanwhile. A fresh run trains from the same step as SB3's.
@@ -17,6 +27,8 @@
 
 #include <torch/torch.h>
 
+#include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -46,6 +58,12 @@ struct OffPolicyConfig {
   // (SpinningUp's SAC, TeachMyAgent's student: 10); train_freq and gradient_steps are then unused.
   int episode_train_freq = 0;
   int report_every = 1000;  // vector steps between progress reports (not SB3)
+  // Collection on its own thread while the learner updates (see OffPolicyLearner): the
+  // collector acts with a copy of the actor refreshed every actor_refresh gradient steps (at the
+  // first handoff after them). Same number of gradient steps per env step as without; off by
+  // default: runs with it are not bitwise the runs without it.
+  bool overlap_collection = false;
+  int actor_refresh = 1;
   void bind(Hyperparameters& table);
   void check(std::string_view algorithm) const;  // UserError for a bad value
 };
@@ -60,7 +78,11 @@ struct OffPolicyNetworkConfig {
 };
 
 // n Q(s, a) networks on one encoder of their own (SB3 ContinuousCritic with
-// share_features_extractor=False): Q_i = MLP_i([encoder(s), a]) -> 1.
+// share_features_extractor=False): Q_i = MLP_i([encoder(s), a]) -> 1. The n MLPs are fused:
+// layer l of every Q is one weight [n, in, out] and one bias [n, 1, out] (Q_i's Linear has
+// weight[i]^T and bias[i]), so each layer of all the critics is one batched matmul (baddbmm)
+// instead of n, forwards and backwards. Same maths as n separate MLPs; same initial values
+// too (drawn in the order separate Linear layers draw them).
 class CriticImpl : public torch::nn::Module {
  public:
   CriticImpl(const ObsShape& shape, int action_size, int critics,
@@ -69,12 +91,25 @@ class CriticImpl : public torch::nn::Module {
   torch::Tensor forward(const ObsBatch& observation, const torch::Tensor& actions);
   // [B]: the first Q only (TD3's actor loss).
   torch::Tensor q1(const ObsBatch& observation, const torch::Tensor& actions);
+  int critics() const { return critics_; }
+  // Layer l of every Q: weight [critics, in, out] and bias [critics, 1, out].
+  const torch::Tensor& weight(size_t layer) const { return weights_[layer]; }
+  const torch::Tensor& bias(size_t layer) const { return biases_[layer]; }
+  size_t layers() const { return weights_.size(); }
 
  private:
+  torch::Tensor activate(const torch::Tensor& x) const;
+
   MultiInputEncoder encoder_{nullptr};
-  std::vector<torch::nn::Sequential> q_;
+  std::vector<torch::Tensor> weights_, biases_;
+  int critics_ = 0;
+  bool relu_ = true;
 };
 TORCH_MODULE(Critic);
+
+// Refuses (UserError naming both formats) a checkpoint whose critic `key` holds the separate
+// critic MLPs of builds before the fused critics (children q1, q2, ...).
+void check_critic_format(torch::serialize::InputArchive& archive, const std::string& key);
 
 // A network's parameters packed (PackedParameters) with a target copy of the same layout.
 // target <- tau * online + (1 - tau) * target is then one operation on two tensors.
@@ -137,6 +172,11 @@ class OffPolicyLearner : public Learner {
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
            bool deterministic) override;
   std::uint64_t parameter_hash() const override;
+  // `count` gradient steps on minibatches of the buffer as it stands, exactly as the loop takes
+  // them (for benchmarks). UserError while the buffer is empty.
+  void update(int count);
+  // Floats of the preprocessed observation vector the networks read (pooled touch included).
+  int observation_size() const { return pipeline_.shape().vector_size; }
 
  protected:
   // Throws UserError for an action space without finite bounds or a replay buffer too large
@@ -151,6 +191,16 @@ class OffPolicyLearner : public Learner {
   // One gradient step on a minibatch (observations already normalised). `update` counts the
   // updates since the start of training, this one included (TD3's delay).
   virtual void train(const ReplayBuffer::Sample& batch, long update) = 0;
+  // overlap_collection: a copy of the acting network for the collector thread (`source`, the
+  // learner's, and `copy` of the same layout, whose parameters the loop refreshes from it), and
+  // the copy's exploration policy, policy_action(observation, false) drawing from `generator`.
+  struct ActorCopy {
+    torch::nn::Module* source = nullptr;
+    std::shared_ptr<torch::nn::Module> copy;
+    std::function<torch::Tensor(const ObsBatch& observation, at::Generator& generator)> explore;
+  };
+  // The default refuses (UserError naming the algorithm).
+  virtual ActorCopy copy_actor();
   // A loss or diagnostic of an update; each report gives the mean of each name's values.
   void record(const std::string& name, double value);
 
@@ -169,6 +219,13 @@ class OffPolicyLearner : public Learner {
   // Whether to train at this step: the buffer holds more than learning_starts transitions (in a
   // data-parallel run, every rank's buffer, so that all start together).
   bool ready_to_train();
+  // `count` gradient steps, minibatches normalised with `statistics`.
+  void run_updates(int count, const RunningMeanStd& statistics);
+  // learn() with overlap_collection.
+  void learn_overlapped(long total_steps, const ProgressFn& on_progress);
+  // The progress report of the steps since `start` (steps since `start_steps`).
+  TrainStats report(std::chrono::steady_clock::time_point start, long start_steps,
+                    double& collect_seconds, double& update_seconds);
 
   const std::string algorithm_;
   VecEnv& env_;

@@ -290,13 +290,18 @@ void ObservationPipeline::process_raw(const VecEnv& env, bool update_stats, ObsB
 }
 
 void ObservationPipeline::normalize(const torch::Tensor& raw, torch::Tensor& out) const {
+  normalize(raw, out, normalizer_);
+}
+
+void ObservationPipeline::normalize(const torch::Tensor& raw, torch::Tensor& out,
+                                    const RunningMeanStd& stats) const {
   if (!config_.normalize_observations) {
     out.copy_(raw);
     return;
   }
   const size_t count = static_cast<size_t>(raw.numel());
-  normalizer_.normalize({raw.data_ptr<float>(), count}, {out.data_ptr<float>(), count},
-                        config_.clip_observations);
+  stats.normalize({raw.data_ptr<float>(), count}, {out.data_ptr<float>(), count},
+                  config_.clip_observations);
 }
 
 void ObservationPipeline::process(const envs::ObservationBuffers& observation, ObsBatch& out) {

@@ -143,6 +143,9 @@ class ObservationPipeline {
   // Normalises raw vectors ([rows, vector_size] float32, contiguous) into `out` (same shape);
   // a copy when normalisation is off.
   void normalize(const torch::Tensor& raw, torch::Tensor& out) const;
+  // The same with given statistics (a copy of normalizer(), taken while a collector thread
+  // updates the pipeline's own).
+  void normalize(const torch::Tensor& raw, torch::Tensor& out, const RunningMeanStd& stats) const;
   // The vector before normalisation (pooled touch included), for tests and intrinsic rewards.
   void raw_vector(const envs::ObservationBuffers& observation, std::span<float> out) const;
 

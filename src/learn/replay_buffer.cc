@@ -71,29 +71,46 @@ void ReplayBuffer::add(const ObsBatch& observation, const torch::Tensor& actions
                        std::span<const double> rewards, const ObsBatch& next,
                        std::span<const std::uint8_t> terminated,
                        std::span<const std::uint8_t> keep) {
-  const long n = observations_.vector.size(1);
-  const long a = actions_.size(1);
   const torch::Tensor source_actions = actions.contiguous();
   for (size_t i = 0; i < keep.size(); ++i) {
     if (!keep[i]) continue;
-    const long row = next_;
-    // Copies one row of a [rows, ...] tensor into row `row` of the storage.
-    auto copy_row = [&](const torch::Tensor& from, torch::Tensor& to, long bytes) {
-      std::memcpy(static_cast<char*>(to.data_ptr()) + row * bytes,
-                  static_cast<const char*>(from.data_ptr()) + i * bytes, bytes);
-    };
-    copy_row(observation.vector, observations_.vector, n * 4);
-    copy_row(next.vector, next_observations_.vector, n * 4);
-    for (size_t k = 0; k < image_bytes_.size(); ++k) {
-      copy_row(observation.images[k], observations_.images[k], image_bytes_[k]);
-      copy_row(next.images[k], next_observations_.images[k], image_bytes_[k]);
-    }
-    copy_row(source_actions, actions_, a * 4);
-    rewards_.data_ptr<float>()[row] = static_cast<float>(rewards[i]);
-    terminated_.data_ptr<std::uint8_t>()[row] = terminated[i] ? 1 : 0;
-    next_ = (next_ + 1) % capacity_;
-    size_ = std::min(size_ + 1, capacity_);
+    put(observation, source_actions, next, static_cast<long>(i), static_cast<float>(rewards[i]),
+        terminated[i] ? 1 : 0);
   }
+}
+
+void ReplayBuffer::append(ReplayBuffer& staging) {
+  const long first = staging.size_ < staging.capacity_ ? 0 : staging.next_;
+  for (long k = 0; k < staging.size_; ++k) {
+    const long from = (first + k) % staging.capacity_;
+    put(staging.observations_, staging.actions_, staging.next_observations_, from,
+        staging.rewards_.data_ptr<float>()[from],
+        staging.terminated_.data_ptr<std::uint8_t>()[from]);
+  }
+  staging.size_ = staging.next_ = 0;
+}
+
+void ReplayBuffer::put(const ObsBatch& observation, const torch::Tensor& actions,
+                       const ObsBatch& next, long from, float reward, std::uint8_t terminated) {
+  const long n = observations_.vector.size(1);
+  const long a = actions_.size(1);
+  const long row = next_;
+  // Copies one row of a [rows, ...] tensor into row `row` of the storage.
+  auto copy_row = [&](const torch::Tensor& source, torch::Tensor& to, long bytes) {
+    std::memcpy(static_cast<char*>(to.data_ptr()) + row * bytes,
+                static_cast<const char*>(source.data_ptr()) + from * bytes, bytes);
+  };
+  copy_row(observation.vector, observations_.vector, n * 4);
+  copy_row(next.vector, next_observations_.vector, n * 4);
+  for (size_t k = 0; k < image_bytes_.size(); ++k) {
+    copy_row(observation.images[k], observations_.images[k], image_bytes_[k]);
+    copy_row(next.images[k], next_observations_.images[k], image_bytes_[k]);
+  }
+  copy_row(actions, actions_, a * 4);
+  rewards_.data_ptr<float>()[row] = reward;
+  terminated_.data_ptr<std::uint8_t>()[row] = terminated;
+  next_ = (next_ + 1) % capacity_;
+  size_ = std::min(size_ + 1, capacity_);
 }
 
 ReplayBuffer::Sample ReplayBuffer::gather(const torch::Tensor& index) const {

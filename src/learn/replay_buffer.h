@@ -55,6 +55,10 @@ class ReplayBuffer {
            std::span<const double> rewards, const ObsBatch& next,
            std::span<const std::uint8_t> terminated, std::span<const std::uint8_t> keep);
 
+  // Appends every transition of `staging` (oldest first), then empties it: the learner merging
+  // what a collector thread stored (OffPolicyConfig::overlap_collection).
+  void append(ReplayBuffer& staging);
+
   struct Sample {
     ObsBatch observations, next_observations;  // raw, as stored
     torch::Tensor actions;                     // [B, action_size] float32
@@ -67,6 +71,10 @@ class ReplayBuffer {
   Sample gather(const torch::Tensor& index) const;
 
  private:
+  // Stores row `from` of the sources as the next transition.
+  void put(const ObsBatch& observation, const torch::Tensor& actions, const ObsBatch& next,
+           long from, float reward, std::uint8_t terminated);
+
   long capacity_, size_ = 0, next_ = 0;
   ObsBatch observations_, next_observations_;
   torch::Tensor actions_, rewards_, terminated_;

@@ -197,6 +197,17 @@ class Sac final : public OffPolicyLearner {
     return actor_->sample(observation, generator()).first;
   }
 
+  ActorCopy copy_actor() override {
+    // The first refresh overwrites the copy's initial values: any generator will do.
+    at::Generator unused = at::make_generator<at::CPUGeneratorImpl>(0);
+    SquashedGaussianActor copy(shape(), action_size(), settings_.networks, unused);
+    return {.source = actor_.ptr().get(),
+            .copy = copy.ptr(),
+            .explore = [copy](const ObsBatch& observation, at::Generator& generator) mutable {
+              return copy->sample(observation, generator).first;
+            }};
+  }
+
   void train(const ReplayBuffer::Sample& batch, long update) override {
     // Reparameterised actions for s, and the temperature step on them.
     auto [pi_actions, log_pi] = actor_->sample(batch.observations, generator());

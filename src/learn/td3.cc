@@ -121,6 +121,22 @@ class Td3 final : public OffPolicyLearner {
     return torch::clamp(mu + config_.exploration_noise * noise, -1.0, 1.0);
   }
 
+  ActorCopy copy_actor() override {
+    // The first refresh overwrites the copy's initial values: any generator will do.
+    at::Generator unused = at::make_generator<at::CPUGeneratorImpl>(0);
+    DeterministicActor copy(shape(), action_size(), settings_.networks, unused);
+    const double noise = config_.exploration_noise;
+    return {
+        .source = actor_.ptr().get(),
+        .copy = copy.ptr(),
+        .explore = [copy, noise](const ObsBatch& observation, at::Generator& generator) mutable {
+          const torch::Tensor mu = copy->forward(observation);
+          if (noise == 0) return mu;
+          return torch::clamp(mu + noise * torch::randn(mu.sizes(), generator, torch::kFloat32),
+                              -1.0, 1.0);
+        }};
+  }
+
   void train(const ReplayBuffer::Sample& batch, long update) override {
     // Target: the target actor's smoothed action, the minimum of the target critics.
     torch::Tensor target;

@@ -1,11 +1,16 @@
 // SAC, TD3 and DDPG: the replay buffer's bookkeeping under next-step autoreset, its memory
 // check, strict hyperparameters, checkpoints, and learning on the inline Pendulum swing-up.
+#include "learn/off_policy.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +44,7 @@ class ScriptedEnv final : public envs::Env {
     observe();
   }
   envs::StepResult step(std::span<const double> action) override {
+    if (--steps_to_failure_ == 0) throw std::runtime_error("scripted env failure");
     last_action_ = action[0];
     ++t_;
     info_.steps = t_;
@@ -49,6 +55,7 @@ class ScriptedEnv final : public envs::Env {
             .truncated = ended && episode_ % 2 == 1};
   }
   double last_action() const { return last_action_; }
+  void fail_at_step(long step) { steps_to_failure_ = step; }
 
  private:
   static DictSpace make_space() {
@@ -67,6 +74,7 @@ class ScriptedEnv final : public envs::Env {
   envs::Info info_;
   int length_, episode_ = -1, t_ = 0;
   double last_action_ = 0;
+  long steps_to_failure_ = -1;  // step() throws when this reaches 0
 };
 
 std::unique_ptr<ThreadedVecEnv> make_scripted(std::vector<int> lengths, double bound = 2.0) {
@@ -181,6 +189,87 @@ TEST(OffPolicy, RejectsBadSettingsAndUnboundedActions) {
   }
   auto unbounded = make_scripted({5}, std::numeric_limits<double>::infinity());
   EXPECT_THROW(make_learner("sac", *unbounded, {}), UserError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fused critics
+
+// The fused critics start from the values n separate Linear MLPs draw from the same generator,
+// and compute what those MLPs compute (forward, q1 and gradients), for relu and tanh.
+TEST(FusedCritic, MatchesSeparateMlpsWithCopiedWeights) {
+  for (const std::string activation : {"relu", "tanh"}) {
+    SCOPED_TRACE(activation);
+    const ObsShape shape{.vector_size = 7};
+    const OffPolicyNetworkConfig config{.qf_layers = {16, 8}, .activation = activation};
+    at::Generator fused_generator = at::make_generator<at::CPUGeneratorImpl>(11);
+    Critic fused(shape, 3, 2, config, fused_generator);
+    at::Generator separate_generator = at::make_generator<at::CPUGeneratorImpl>(11);
+    std::vector<torch::nn::Sequential> separate;
+    for (int i = 0; i < 2; ++i) {
+      torch::nn::Sequential q = make_mlp(10, config.qf_layers, activation);
+      q->push_back(torch::nn::Linear(8, 1));
+      init_layers(*q, 1.0, /*orthogonal=*/false, separate_generator);
+      separate.push_back(q);
+    }
+    // Same initial values, bit for bit.
+    for (int i = 0; i < 2; ++i) {
+      size_t l = 0;
+      for (const auto& child : separate[i]->children()) {
+        auto* linear = child->as<torch::nn::Linear>();
+        if (linear == nullptr) continue;
+        EXPECT_TRUE(torch::equal(fused->weight(l)[i], linear->weight.t()));
+        EXPECT_TRUE(torch::equal(fused->bias(l)[i][0], linear->bias));
+        ++l;
+      }
+      EXPECT_EQ(l, fused->layers());
+    }
+    // Same values and gradients on a batch.
+    ObsBatch obs = ObsBatch::zeros(shape, 5);
+    obs.vector.copy_(torch::randn({5, 7}, fused_generator));
+    const torch::Tensor actions = torch::rand({5, 3}, fused_generator) * 2 - 1;
+    const torch::Tensor q = fused->forward(obs, actions);
+    ASSERT_EQ(q.sizes(), (std::vector<int64_t>{2, 5}));
+    const torch::Tensor input = torch::cat({obs.vector, actions}, 1);
+    std::vector<torch::Tensor> expected;
+    for (auto& mlp : separate) expected.push_back(mlp->forward(input).squeeze(1));
+    EXPECT_TRUE(torch::allclose(q, torch::stack(expected), 1e-5, 1e-6));
+    EXPECT_TRUE(torch::allclose(fused->q1(obs, actions), expected[0], 1e-5, 1e-6));
+    q.square().sum().backward();
+    (expected[0].square().sum() + expected[1].square().sum()).backward();
+    for (int i = 0; i < 2; ++i) {
+      const auto* first = separate[i]->children()[0]->as<torch::nn::Linear>();
+      EXPECT_TRUE(
+          torch::allclose(fused->weight(0).grad()[i], first->weight.grad().t(), 1e-4, 1e-5));
+      EXPECT_TRUE(torch::allclose(fused->bias(0).grad()[i][0], first->bias.grad(), 1e-4, 1e-5));
+    }
+  }
+}
+
+// A critic saved as separate MLPs (q1, q2: checkpoints from before the fused critics) is
+// refused with one line naming both formats; a fused one passes.
+TEST(FusedCritic, RefusesTheSeparateMlpFormat) {
+  auto archive_of = [](const std::string& child) {
+    torch::serialize::OutputArchive out, critic, q;
+    q.write("weight", torch::zeros({1, 2}));
+    critic.write(child, q);
+    out.write("critic", critic);
+    std::ostringstream bytes;
+    out.save_to(bytes);
+    auto in = std::make_unique<torch::serialize::InputArchive>();
+    std::istringstream stream(bytes.str());
+    in->load_from(stream);
+    return in;
+  };
+  try {
+    check_critic_format(*archive_of("q1"), "critic");
+    ADD_FAILURE() << "the separate-MLP format was accepted";
+  } catch (const UserError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("separate critic MLPs"), std::string::npos) << message;
+    EXPECT_NE(message.find("fused critics"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  EXPECT_NO_THROW(check_critic_format(*archive_of("encoder"), "critic"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -312,6 +401,100 @@ TEST(Sac, DeterministicGivenTheSeed) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Overlapped collection
+
+// The collector thread changes which actions are taken, never how much is learned: the same
+// env steps, buffer sizes and gradient steps at every report as the synchronous loop, for every
+// off-policy algorithm and for train_freq > 1.
+TEST(OverlapCollection, KeepsTheUpdateToDataRatio) {
+  for (const std::string algorithm : {"sac", "td3", "ddpg"}) {
+    for (const std::string train_freq : {"1", "3"}) {
+      SCOPED_TRACE(algorithm + " train_freq " + train_freq);
+      auto counts = [&](const std::string& overlap) {
+        // Episodes of fixed lengths: the stored transitions do not depend on the actions.
+        auto env = make_scripted({10, 7});
+        auto learner = make_learner(algorithm, *env,
+                                    {.seed = 5,
+                                     .hyperparameters = small({{"overlap_collection", overlap},
+                                                               {"train_freq", train_freq},
+                                                               {"gradient_steps", "2"},
+                                                               {"report_every", "12"}})});
+        std::vector<double> seen;
+        learner->learn(200, [&](const TrainStats& stats) {
+          seen.push_back(static_cast<double>(stats.steps));
+          seen.push_back(stats.losses.at("updates"));
+          seen.push_back(stats.losses.at("buffer_transitions"));
+          for (const auto& [name, value] : stats.losses) EXPECT_TRUE(std::isfinite(value)) << name;
+          return true;
+        });
+        EXPECT_EQ(learner->steps(), 200);
+        return seen;
+      };
+      const std::vector<double> sync = counts("false");
+      EXPECT_GT(sync.size(), 6u);
+      EXPECT_EQ(counts("true"), sync);
+    }
+  }
+}
+
+// Stopped by the progress callback: learn() returns at that report with the collector joined;
+// a checkpoint written there loads into a learner that acts the same.
+TEST(OverlapCollection, StopsAtAReportWithAConsistentCheckpoint) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "cradle_overlap_stop.pt";
+  auto env_a = testing::make_cartpoles(2, 30);
+  auto env_b = testing::make_cartpoles(2, 30);
+  const auto hp = small({{"overlap_collection", "true"}, {"report_every", "40"}});
+  auto a = make_learner("sac", *env_a, {.seed = 3, .hyperparameters = hp});
+  auto b = make_learner("sac", *env_b, {.seed = 4, .hyperparameters = hp});
+  int reports = 0;
+  a->learn(1'000'000, [&](const TrainStats& stats) {
+    EXPECT_EQ(stats.steps, 80L * (reports + 1));
+    a->save(file);
+    return ++reports < 3;
+  });
+  EXPECT_EQ(reports, 3);
+  EXPECT_EQ(a->steps(), 240);
+  b->load(file);
+  EXPECT_EQ(b->steps(), 240);
+  EXPECT_EQ(actions_of(*a, false, true), actions_of(*b, false, true));
+  // And it runs on from there.
+  a->learn(320, {});
+  EXPECT_EQ(a->steps(), 320);
+  std::filesystem::remove(file);
+}
+
+// An env failing on the collector thread fails learn() on the caller's thread, with the
+// collector joined (no hang, no terminate), as a sync run would fail.
+TEST(OverlapCollection, RethrowsTheCollectorsFailure) {
+  std::vector<std::unique_ptr<envs::Env>> list;
+  auto scripted = std::make_unique<ScriptedEnv>(10, 2.0);
+  scripted->fail_at_step(150);
+  list.push_back(std::move(scripted));
+  ThreadedVecEnv env(std::move(list), /*threads=*/1);
+  auto learner =
+      make_learner("sac", env, {.hyperparameters = small({{"overlap_collection", "true"}})});
+  EXPECT_THROW(learner->learn(1000, {}), std::runtime_error);
+  // The 150th step call is vector step 164 (14 autoresets before it): nothing after it counts.
+  EXPECT_GT(learner->steps(), 100);
+  EXPECT_LT(learner->steps(), 165);
+}
+
+// Settings it cannot honour are refused, each with its one-line reason.
+TEST(OverlapCollection, RefusesWhatItCannotRun) {
+  auto env = testing::make_cartpoles(1, 30);
+  EXPECT_THROW(make_learner("sac", *env, {.hyperparameters = {{"actor_refresh", "0"}}}), UserError);
+  auto episodic = make_learner(
+      "sac", *env,
+      {.hyperparameters = small({{"overlap_collection", "true"}, {"episode_train_freq", "10"}})});
+  EXPECT_THROW(episodic->learn(100, {}), UserError);
+  auto images = testing::make_cartpoles(1, 30, /*with_image=*/true);
+  auto seeing =
+      make_learner("sac", *images, {.hyperparameters = small({{"overlap_collection", "true"}})});
+  EXPECT_THROW(seeing->learn(100, {}), UserError);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Learning: Pendulum swing-up (episodes of 200 steps). A random policy scores about -1,200;
 // swinging up and balancing scores above -400 (about -150 from most starts).
 
@@ -383,6 +566,15 @@ const std::map<std::string, std::string> kPendulumHp = {{"pi_layers", "64,64"},
 TEST(Sac, LearnsPendulumSwingUp) {
   const PendulumRun run = learn_pendulum("sac", 6000, kPendulumHp);
   EXPECT_LT(run.random, -900);
+  EXPECT_GT(run.learned, -400);
+}
+
+// With the collector on its own thread (acting with an actor one update old) SAC still swings
+// the pendulum up.
+TEST(Sac, LearnsPendulumSwingUpWithOverlappedCollection) {
+  std::map<std::string, std::string> hp = kPendulumHp;
+  hp["overlap_collection"] = "true";
+  const PendulumRun run = learn_pendulum("sac", 6000, hp);
   EXPECT_GT(run.learned, -400);
 }
 

@@ -285,6 +285,7 @@ long ContextSac::load(const std::filesystem::path& file) {
         // Every module's shape is checked before anything changes.
         std::vector<std::function<void()>> copies;
         copies.push_back(stage_module(archive, "actor", *actor_));
+        check_critic_format(archive, "critic");
         copies.push_back(stage_module(archive, "critic", *critic_));
         copies.push_back(stage_module(archive, "critic_target", *critic_target_));
         copies.push_back(stage_module(archive, "encoder", *encoders_.online));
