@@ -22,6 +22,7 @@
 #include "learn/intrinsic/features.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
+#include "learn/intrinsic/regard_count.h"
 #include "learn/intrinsic/reward.h"
 #include "learn/intrinsic/rnd.h"
 #include "learn/intrinsic/saliency.h"
@@ -670,6 +671,48 @@ TEST(EpisodeCoverage, EpisodeSumIsTheSelfTouchScoreOnTheRealEnv) {
   // Without a self-touch behaviour there is nothing to pay for: a one-line error.
   config.behavior = Behavior::kNone;
   auto plain = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 5);
+  EXPECT_THROW(reward.bind(*plain), UserError);
+}
+
+TEST(RegardCount, EpisodeSumIsTheEitherHandCountOnTheRealEnv) {
+  Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_handregard.yml");
+  config.vision_active = false;  // the counters come from geometry, not from the images
+  config.max_episode_steps = 60;
+  config.hand_regard_half_angle = 60;  // wide cones, so that some steps count
+  auto vec = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 2);
+  RegardCount reward(3.0);
+  reward.bind(*vec);
+  vec->reset(2);
+  reward.reset(*vec);
+  std::vector<double> actions(vec->action_space().size()), rewards(1);
+  double episode_sum = 0, autoreset_reward = -1;
+  int episodes = 0;
+  bool ended = false;
+  for (int t = 0; t < 70; ++t) {
+    for (size_t k = 0; k < actions.size(); ++k) actions[k] = std::sin(0.1 * t + 0.7 * k);
+    vec->step(actions);
+    rewards[0] = 0;
+    reward.compute(*vec, actions, rewards);
+    if (ended) autoreset_reward = rewards[0];
+    ended = false;
+    episode_sum += rewards[0];
+    if (vec->terminated()[0] || vec->truncated()[0]) {
+      const envs::Info& info = vec->info(0);
+      const double either = info.number(info.find("right_eye_either_hand")) +
+                            info.number(info.find("left_eye_either_hand"));
+      EXPECT_GT(either, 0);
+      EXPECT_NEAR(episode_sum, 3.0 * either / 2, 1e-12);
+      ++episodes;
+      ended = true;
+      episode_sum = 0;
+    }
+  }
+  EXPECT_EQ(episodes, 1);
+  EXPECT_EQ(autoreset_reward, 0.0);  // the autoreset step is no transition
+
+  config.behavior = Behavior::kNone;
+  auto plain = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 2);
   EXPECT_THROW(reward.bind(*plain), UserError);
 }
 

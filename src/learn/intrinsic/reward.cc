@@ -12,6 +12,7 @@
 #include "learn/intrinsic/episode_coverage.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
+#include "learn/intrinsic/regard_count.h"
 #include "learn/intrinsic/rnd.h"
 #include "learn/intrinsic/saliency.h"
 #include "learn/intrinsic/touch_count.h"
@@ -34,6 +35,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"body_part_novelty", factory<BodyPartNovelty>()},
       {"episode_coverage", factory<EpisodeCoverage>()},
       {"hand_visibility", factory<HandVisibility>()},
+      {"regard_count", factory<RegardCount>()},
       {"rnd", factory<Rnd>()},
       {"icm", factory<Icm>()},
       {"disagreement", factory<Disagreement>()},
