@@ -7,7 +7,7 @@
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
-#include "eval/evaluation.h"
+#include "train/evaluation.h"
 #include "train/trainer.h"
 
 namespace cradle::apps {
@@ -47,15 +47,15 @@ void register_evaluate(CLI::App& app) {
   cmd->callback([opts] {
     Config config = load_config(opts->config);
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
-    eval::EvaluationOptions options{.episodes = opts->episodes,
-                                    .duration = opts->duration,
-                                    .render = opts->render,
-                                    .seed = opts->seed,
-                                    .video_extension = "." + opts->format};
+    train::EvaluationOptions options{.episodes = opts->episodes,
+                                     .duration = opts->duration,
+                                     .render = opts->render,
+                                     .seed = opts->seed,
+                                     .video_extension = "." + opts->format};
     const std::string behavior(behavior_name(config.behavior));
-    const eval::Policy policy =
+    const train::Policy policy =
         opts->policy.empty() ? nullptr : train::load_policy(config, opts->policy);
-    const eval::EvaluationReport r = eval::evaluate(config, options, policy);
+    const train::EvaluationReport r = train::evaluate(config, options, policy);
     if (r.training_score) {
       std::printf("training log: %d entries, score %.4f\n", r.training_episodes, *r.training_score);
     } else {

@@ -17,8 +17,8 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/rng.h"
-#include "eval/evaluation.h"
 #include "train/babybench_vector.h"
+#include "train/evaluation.h"
 
 namespace cradle::apps {
 namespace {
@@ -79,13 +79,13 @@ void register_soak(CLI::App& app) {
     auto evaluate = [&](const char* when) {
       Config ec = config;
       ec.save_dir = (dir / ("soak_eval_" + std::to_string(evaluations++))).string();
-      const eval::EvaluationOptions eo{.episodes = opts->eval_episodes,
-                                       .duration = opts->eval_duration,
-                                       .render = !opts->no_video,
-                                       .seed = opts->seed + 1000,
-                                       .quiet = true};
+      const train::EvaluationOptions eo{.episodes = opts->eval_episodes,
+                                        .duration = opts->eval_duration,
+                                        .render = !opts->no_video,
+                                        .seed = opts->seed + 1000,
+                                        .quiet = true};
       const Clock::time_point t = Clock::now();
-      const eval::EvaluationReport report = eval::evaluate(ec, eo);
+      const train::EvaluationReport report = train::evaluate(ec, eo);
       std::printf("evaluation %d (%s): %zu episodes, mean score %.4f, %.1f s\n", evaluations, when,
                   report.episodes.size(), report.mean,
                   std::chrono::duration<double>(Clock::now() - t).count());

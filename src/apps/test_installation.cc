@@ -13,8 +13,8 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "envs/babybench.h"
-#include "eval/frames.h"
 #include "eval/video.h"
+#include "train/frames.h"
 
 namespace cradle::apps {
 
@@ -37,7 +37,7 @@ void register_test_installation(CLI::App& app) {
     try {
       auto env = envs::make_env(config, /*training=*/true);
       env->reset(0);
-      eval::FrameComposer composer(*env);
+      train::FrameComposer composer(*env);
       std::vector<std::uint8_t> image(480 * 480 * 3);
       eval::VideoWriter video(dir / "videos" / "test_installation.mp4", 480, 480, 60);
       const Box& space = env->action_space();

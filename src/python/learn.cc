@@ -13,12 +13,12 @@
 
 #include "core/error.h"
 #include "envs/babybench.h"
-#include "eval/evaluation.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
 #include "learn/vector_env.h"
 #include "python/common.h"
 #include "train/babybench_vector.h"
+#include "train/evaluation.h"
 #include "train/trainer.h"
 
 namespace cradle::python {
@@ -303,7 +303,7 @@ class PyRewardHook {
 // A Python policy for evaluation: fn(obs dict) -> action, with fresh observation arrays.
 // The callable is held through a shared_ptr: copies of the std::function made by C++ code
 // without the GIL then never touch Python reference counts.
-eval::Policy python_policy(py::object callable) {
+train::Policy python_policy(py::object callable) {
   auto fn = std::make_shared<py::object>(std::move(callable));
   auto entries = std::make_shared<std::vector<Entry>>();
   return [fn, entries](const envs::BabyBenchEnv& env, std::span<double> action) {
@@ -326,7 +326,7 @@ eval::Policy python_policy(py::object callable) {
 
 // A trained checkpoint's deterministic policy (cradle.load_policy).
 struct PyPolicy {
-  eval::Policy policy;
+  train::Policy policy;
   int action_dim = 0;
 };
 
@@ -414,13 +414,13 @@ void bind_learn(py::module_& m) {
       "evaluate",
       [](const Config& config, int episodes, int duration, bool render, std::uint64_t seed,
          const std::string& video_extension, bool quiet, const py::object& policy) {
-        eval::EvaluationOptions o{.episodes = episodes,
-                                  .duration = duration,
-                                  .render = render,
-                                  .seed = seed,
-                                  .video_extension = video_extension,
-                                  .quiet = quiet};
-        eval::Policy p;
+        train::EvaluationOptions o{.episodes = episodes,
+                                   .duration = duration,
+                                   .render = render,
+                                   .seed = seed,
+                                   .video_extension = video_extension,
+                                   .quiet = quiet};
+        train::Policy p;
         if (py::isinstance<PyPolicy>(policy)) {
           p = policy.cast<const PyPolicy&>().policy;
         } else if (py::isinstance<py::str>(policy)) {
@@ -429,7 +429,7 @@ void bind_learn(py::module_& m) {
         } else if (!policy.is_none()) {
           p = python_policy(policy);
         }
-        return without_gil([&] { return eval::evaluate(config, o, p); }).to_json().dump();
+        return without_gil([&] { return train::evaluate(config, o, p); }).to_json().dump();
       },
       py::arg("config"), py::arg("episodes"), py::arg("duration"), py::arg("render"),
       py::arg("seed"), py::arg("video_extension"), py::arg("quiet"), py::arg("policy"),

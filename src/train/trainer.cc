@@ -394,27 +394,27 @@ TrainResult train(const Config& config, const TrainOptions& options) {
 
   // The trained policy's evaluation, acting deterministically.
   if (options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
-    eval::EvaluationOptions eo{.episodes = options.eval_episodes,
-                               .duration = options.eval_duration,
-                               .render = options.eval_render,
-                               .seed = options.seed + 1000,
-                               .quiet = true};
+    train::EvaluationOptions eo{.episodes = options.eval_episodes,
+                                .duration = options.eval_duration,
+                                .render = options.eval_render,
+                                .seed = options.seed + 1000,
+                                .quiet = true};
     Learner* l = learner.get();
     result.evaluation =
-        eval::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
+        train::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
           l->act(env.observation(), action, /*deterministic=*/true);
         });
     if (options.compare_random) {
       Config baseline = config;
       baseline.save_dir = (dir / "random_baseline").string();
       eo.render = false;
-      result.random_evaluation = eval::evaluate(baseline, eo);
+      result.random_evaluation = train::evaluate(baseline, eo);
     }
   }
   return result;
 }
 
-eval::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint) {
+train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint) {
   if (!fs::exists(checkpoint)) {
     throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
   }

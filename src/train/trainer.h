@@ -13,8 +13,8 @@
 #include <string>
 
 #include "core/config.h"
-#include "eval/evaluation.h"
 #include "learn/learner.h"
+#include "train/evaluation.h"
 
 namespace cradle::train {
 
@@ -62,8 +62,8 @@ struct TrainResult {
   double seconds = 0;
   double steps_per_second = 0;
   std::optional<double> training_score;  // from the env training log
-  std::optional<eval::EvaluationReport> evaluation;
-  std::optional<eval::EvaluationReport> random_evaluation;
+  std::optional<train::EvaluationReport> evaluation;
+  std::optional<train::EvaluationReport> random_evaluation;
   std::filesystem::path checkpoint;
   std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };
@@ -71,6 +71,6 @@ struct TrainResult {
 TrainResult train(const Config& config, const TrainOptions& options);
 
 // The policy of a checkpoint, for `cradle evaluate --policy` (deterministic actions).
-eval::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint);
+train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint);
 
 }  // namespace cradle::train

@@ -1,4 +1,4 @@
-#include "eval/evaluation.h"
+#include "train/evaluation.h"
 
 #include <mujoco/mujoco.h>
 
@@ -14,11 +14,11 @@
 #include "core/npz.h"
 #include "core/rng.h"
 #include "eval/figures.h"
-#include "eval/frames.h"
 #include "eval/log_check.h"
 #include "eval/video.h"
+#include "train/frames.h"
 
-namespace cradle::eval {
+namespace cradle::train {
 namespace {
 
 namespace fs = std::filesystem;
@@ -35,10 +35,10 @@ struct Trajectory {
 // the task's geom lists when it has some).
 void plot_training_log(const envs::EvaluationPanels& panels,
                        const std::vector<nlohmann::json>& entries, const fs::path& file,
-                       Figures& figures) {
-  Series per_episode{.label = "episode score", .points = true};
+                       eval::Figures& figures) {
+  eval::Series per_episode{.label = "episode score", .points = true};
   const auto& lists = panels.geom_lists;
-  Series cumulative{.label = lists ? lists->union_label : ""};
+  eval::Series cumulative{.label = lists ? lists->union_label : ""};
   std::vector<std::set<int>> seen(lists ? lists->keys.size() : 0);
   for (size_t i = 0; i < entries.size(); ++i) {
     const nlohmann::json& e = entries[i];
@@ -55,10 +55,10 @@ void plot_training_log(const envs::EvaluationPanels& panels,
       cumulative.y.push_back(static_cast<double>(count) / lists->union_denominator);
     }
   }
-  LinePlot plot{.title = "Training log: score per episode",
-                .x_label = "episode",
-                .y_label = "score",
-                .series = {per_episode}};
+  eval::LinePlot plot{.title = "Training log: score per episode",
+                      .x_label = "episode",
+                      .y_label = "score",
+                      .series = {per_episode}};
   if (!cumulative.y.empty()) plot.series.push_back(cumulative);
   figures.add(plot, file);
 }
@@ -67,12 +67,12 @@ void plot_training_log(const envs::EvaluationPanels& panels,
 // (self-touch: touched by each hand) over the evaluation episodes.
 void plot_coverage(const mjModel* m, const envs::EvaluationPanels::GeomLists& lists,
                    const std::vector<std::vector<std::set<int>>>& episode_lists,
-                   const fs::path& file, Figures& figures) {
-  BarChart chart{.title = lists.title,
-                 .y_label = "fraction of geoms touched",
-                 .group_labels = lists.labels,
-                 .values = std::vector<std::vector<double>>(lists.keys.size()),
-                 .y_range = std::make_pair(0.0, 1.0)};
+                   const fs::path& file, eval::Figures& figures) {
+  eval::BarChart chart{.title = lists.title,
+                       .y_label = "fraction of geoms touched",
+                       .group_labels = lists.labels,
+                       .values = std::vector<std::vector<double>>(lists.keys.size()),
+                       .y_range = std::make_pair(0.0, 1.0)};
   std::vector<std::set<int>> touched(lists.keys.size());
   for (const auto& episode : episode_lists) {
     for (size_t k = 0; k < touched.size(); ++k)
@@ -101,13 +101,13 @@ void plot_coverage(const mjModel* m, const envs::EvaluationPanels::GeomLists& li
 
 // The task's per-step trace over one episode, one line per value, with its threshold.
 void plot_trace(const envs::EvaluationPanels::Trace& trace, const std::vector<double>& values,
-                const fs::path& file, Figures& figures) {
-  LinePlot plot{
+                const fs::path& file, eval::Figures& figures) {
+  eval::LinePlot plot{
       .title = trace.title, .x_label = "step", .y_label = trace.y_label, .y_range = trace.y_range};
   if (trace.threshold) plot.h_lines.push_back(*trace.threshold);
   const size_t width = trace.labels.size();
   for (size_t k = 0; k < width; ++k) {
-    Series s{.label = trace.labels[k]};
+    eval::Series s{.label = trace.labels[k]};
     for (size_t t = 0; width * t + k < values.size(); ++t) s.y.push_back(values[width * t + k]);
     plot.series.push_back(std::move(s));
   }
@@ -157,11 +157,11 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   const fs::path log_file = dir / "logs" / "training.jsonl";
   std::vector<nlohmann::json> log;
   if (fs::exists(log_file)) {
-    log = read_training_log(log_file, config.behavior, m->ngeom);
+    log = eval::read_training_log(log_file, config.behavior, m->ngeom);
     report.training_episodes = static_cast<int>(log.size());
-    report.training_score = training_score(config.behavior, log);
+    report.training_score = eval::training_score(config.behavior, log);
     if (config.behavior == Behavior::kHandRegard)
-      report.training_hand_regard = hand_regard_score(log);
+      report.training_hand_regard = eval::hand_regard_score(log);
   }
   const Policy policy = given_policy ? given_policy : random_policy(options.seed ^ 0x5eedULL);
   // What the task shows: its video panels, per-step trace and geom-list charts.
@@ -187,7 +187,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
     env.reset(options.seed + static_cast<std::uint64_t>(i));
     Trajectory traj;
     traj.qpos.reserve(static_cast<size_t>(options.duration) * m->nq);
-    std::optional<VideoWriter> video;
+    std::optional<eval::VideoWriter> video;
     if (options.render) {
       video.emplace(dir / "videos" / ("episode_" + std::to_string(i) + options.video_extension),
                     FrameComposer::kWidth, FrameComposer::kHeight, fps);
@@ -233,7 +233,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
     if (config.behavior == Behavior::kHandRegard) {
       nlohmann::json entry = info.to_json();
       entry["steps"] = options.duration;
-      result.hand_regard = hand_regard_episode_score(entry);
+      result.hand_regard = eval::hand_regard_episode_score(entry);
     }
     result.wall_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -252,7 +252,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   report.std = std::sqrt(sq / options.episodes);
 
   // Plots (matplotlib, from plots/figures.json).
-  Figures figures;
+  eval::Figures figures;
   const fs::path plots = dir / "plots";
   if (!log.empty()) plot_training_log(panels, log, plots / "training_score.png", figures);
   if (panels.geom_lists) {
@@ -303,4 +303,4 @@ nlohmann::json EvaluationReport::to_json() const {
   return j;
 }
 
-}  // namespace cradle::eval
+}  // namespace cradle::train

@@ -12,7 +12,7 @@
 #include "envs/babybench.h"
 #include "senses/vision.h"
 
-namespace cradle::eval {
+namespace cradle::train {
 
 class FrameComposer {
  public:
@@ -65,4 +65,4 @@ class FrameComposer {
   std::vector<double> sensor_col_, sensor_row_, sensor_radius_, sensor_force_;
 };
 
-}  // namespace cradle::eval
+}  // namespace cradle::train

@@ -15,7 +15,7 @@
 #include "envs/babybench.h"
 #include "eval/scores.h"
 
-namespace cradle::eval {
+namespace cradle::train {
 
 // Fills `action` for the env's current observation.
 using Policy = std::function<void(const envs::BabyBenchEnv& env, std::span<double> action)>;
@@ -32,15 +32,15 @@ struct EvaluationOptions {
 
 struct EpisodeResult {
   int steps = 0;
-  double score = 0;                            // the behaviour's episode score (NaN for none)
-  std::optional<HandRegardScore> hand_regard;  // both definitions, hand regard only
+  double score = 0;                                  // the behaviour's episode score (NaN for none)
+  std::optional<eval::HandRegardScore> hand_regard;  // both definitions, hand regard only
   std::vector<int> right_hand_touches, left_hand_touches;
   double wall_seconds = 0;
 };
 
 struct EvaluationReport {
   std::optional<double> training_score;  // from logs/training.jsonl, if there is one
-  std::optional<HandRegardScore> training_hand_regard;
+  std::optional<eval::HandRegardScore> training_hand_regard;
   int training_episodes = 0;
   std::vector<EpisodeResult> episodes;
   double mean = 0, std = 0;  // of the episode scores
@@ -54,4 +54,4 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
 // The random policy: uniform within the action bounds, from its own seeded generator.
 Policy random_policy(std::uint64_t seed);
 
-}  // namespace cradle::eval
+}  // namespace cradle::train

@@ -1,7 +1,7 @@
 // Evaluation video frames: layout, panel choice per behaviour, the touch map's colours, the
 // anaglyph's channels and determinism, on the reference configs. Frames are also written as PNG
 // to /tmp/cradle_frames/ for looking at.
-#include "eval/frames.h"
+#include "train/frames.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include "envs/babybench.h"
 #include "envs/self_touch.h"
 
-namespace cradle::eval {
+namespace cradle::train {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
@@ -250,4 +250,4 @@ TEST(FrameComposer, HandRegardAnaglyph) {
 }
 
 }  // namespace
-}  // namespace cradle::eval
+}  // namespace cradle::train

@@ -1,4 +1,4 @@
-#include "eval/frames.h"
+#include "train/frames.h"
 
 #include <mujoco/mujoco.h>
 
@@ -28,7 +28,7 @@
 // goes 32 -> 13 ms and a 240x240 panel 18 -> 9 ms without it, at the price of stair-stepped edges
 // on the crib's bars. The touch map itself is ~3 ms (5683 markers).
 
-namespace cradle::eval {
+namespace cradle::train {
 namespace {
 
 using Panel = FrameComposer::Panel;
@@ -305,4 +305,4 @@ void FrameComposer::place_panel(int top_row, std::span<std::uint8_t> frame) cons
   }
 }
 
-}  // namespace cradle::eval
+}  // namespace cradle::train
