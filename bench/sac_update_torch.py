@@ -142,22 +142,23 @@ def python_rate(obs, fused, threads, seconds):
     sac = Sac(obs, fused)
     for _ in range(3):
         sac.step()
-    steps, t0 = 0, time.perf_counter()
+    steps, t0, c0 = 0, time.perf_counter(), time.process_time()
     while time.perf_counter() - t0 < seconds:
         sac.step()
         steps += 1
-    return steps / (time.perf_counter() - t0)
+    return steps / (time.perf_counter() - t0), 1000 * (time.process_time() - c0) / steps
 
 
 def cradle_rates(binary, seconds):
-    """{threads: (gradient steps/s, obs_dim)} from one run of the C++ benchmark."""
+    """{threads: (gradient steps/s, CPU ms per step, obs_dim)} from one run of the C++ benchmark
+    (its CPU time is the timing thread's: a lower bound with 2 threads)."""
     out = subprocess.run([binary, "--benchmark_filter=BM_SacGradientStep",
                           "--benchmark_format=json", f"--benchmark_min_time={seconds}"],
                          check=True, capture_output=True, text=True).stdout
     rates = {}
     for b in json.loads(out)["benchmarks"]:
-        rates[int(b["name"].split("threads:")[1].split("/")[0])] = (b["gradient_steps_per_s"],
-                                                                  int(b["obs_dim"]))
+        threads = int(b["name"].split("threads:")[1].split("/")[0])
+        rates[threads] = (b["gradient_steps_per_s"], b["cpu_time"], int(b["obs_dim"]))
     return rates
 
 
@@ -174,8 +175,8 @@ def main():
     obs = args.obs_dim
     for _ in range(args.rounds):
         if args.cradle_bench:
-            for threads, (rate, dim) in cradle_rates(args.cradle_bench, args.seconds).items():
-                table.setdefault(("cradle (fused)", threads), []).append(rate)
+            for threads, (rate, cpu, dim) in cradle_rates(args.cradle_bench, args.seconds).items():
+                table.setdefault(("cradle (fused)", threads), []).append((rate, cpu))
                 obs = obs or dim
         obs = obs or 500
         for threads in args.threads:
@@ -184,13 +185,17 @@ def main():
                 table.setdefault((who, threads), []).append(
                     python_rate(obs, fused, threads, args.seconds))
     print(f"SAC gradient step, obs {obs}, action {ACTIONS}, 256-256, batch {BATCH}: "
-          f"median of {args.rounds} rounds, gradient steps/s")
-    for (who, threads), rates in sorted(table.items(), key=lambda kv: (kv[0][1], kv[0][0])):
-        rate = statistics.median(rates)
-        line = f"  threads {threads}  {who:22s} {rate:7.1f}/s  {1000 / rate:6.2f} ms"
+          f"median of {args.rounds} rounds; wall and CPU time per step (CPU: robust to a loaded "
+          f"machine)")
+    for (who, threads), runs in sorted(table.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+        rate = statistics.median(r for r, _ in runs)
+        cpu = statistics.median(c for _, c in runs)
+        line = (f"  threads {threads}  {who:22s} {rate:7.1f}/s  wall {1000 / rate:7.2f} ms  "
+                f"cpu {cpu:7.2f} ms")
         base = table.get(("torch separate (SB3)", threads))
         if base and who != "torch separate (SB3)":
-            line += f"  x{rate / statistics.median(base):.2f} of torch separate"
+            line += (f"  speed x{rate / statistics.median(r for r, _ in base):.2f}, cpu "
+                     f"x{statistics.median(c for _, c in base) / cpu:.2f} of torch separate")
         print(line)
 
 
