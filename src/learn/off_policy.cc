@@ -367,7 +367,7 @@ void OffPolicyLearner::learn_overlapped(long total_steps, const ProgressFn& on_p
   order();
   long refreshed = updates_;  // updates_ at the last refresh
   RunningMeanStd statistics;  // the normaliser's at the handoff, for the learner's minibatches
-  bool report_due = false;  // by the transitions merged at the last handoff
+  bool report_due = false;    // by the transitions merged at the last handoff
   while (true) {
     // Handoff: the collector is idle and the last merge's updates are done. Report those (the
     // synchronous loop's reports, at the same steps), then merge and count the staged ones.
