@@ -137,6 +137,7 @@ class OffPolicyLearner : public Learner {
   void act(const envs::ObservationBuffers& observation, std::span<double> action,
            bool deterministic) override;
   std::uint64_t parameter_hash() const override;
+  double value(const envs::ObservationBuffers& observation) override;
 
  protected:
   // Throws UserError for an action space without finite bounds or a replay buffer too large
@@ -148,6 +149,8 @@ class OffPolicyLearner : public Learner {
   // Actions in [-1, 1] for the current observations: the behaviour policy (deterministic:
   // the policy's best guess, for evaluation). [rows, action_size].
   virtual torch::Tensor policy_action(const ObsBatch& observation, bool deterministic) = 0;
+  // The value of each observation [rows] (Learner::value); undefined: the algorithm has none.
+  virtual torch::Tensor state_value(const ObsBatch& /*observation*/) { return {}; }
   // One gradient step on a minibatch (observations already normalised). `update` counts the
   // updates since the start of training, this one included (TD3's delay).
   virtual void train(const ReplayBuffer::Sample& batch, long update) = 0;

@@ -169,6 +169,10 @@ class Ppo final : public Learner {
                  deterministic);
   }
 
+  double value(const envs::ObservationBuffers& observation) override {
+    return state_value(pipeline_, policy_, observation, scratch_);
+  }
+
  private:
   // n_epochs passes of minibatch gradient steps over the rollout's valid rows.
   std::map<std::string, double> update() {
