@@ -86,15 +86,15 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   fs::remove_all(dir);
 }
 
-// A curriculum on catch: the teacher's throws reach the training envs and every training
-// episode is booked with its task inside the file's box.
+// A curriculum on catch (the shipped file): the teacher's throws reach the training envs and every
+// training episode is booked with its task inside the file's box.
 TEST(Illustrate, CatchCurriculumBooksEveryTrainingEpisode) {
   const fs::path dir = cradle::test::fresh_dir("illustrate_curriculum");
   const std::string file = std::string(CRADLE_SOURCE_DIR) + "/configs/curricula/mimo_catch.yml";
   const CliResult r = cradle_in(dir,
                                 "illustrate --env catch --algorithm PPO --train_for 256 "
                                 "--test_for 0 --save_model cur --hp n_steps=128 --hp batch_size=64 "
-                                "--teacher Random --task-space " +
+                                "--task-space " +
                                     file);
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream book(dir / "models" / "catch" / "cur" / "teacher.jsonl");
@@ -108,7 +108,7 @@ TEST(Illustrate, CatchCurriculumBooksEveryTrainingEpisode) {
       EXPECT_GE(task[1], 0.0);  // ball_speed in [0, 2]
       EXPECT_LE(task[1], 2.0);
     } else {
-      EXPECT_EQ(j["teacher"]["teacher"], "random");
+      EXPECT_EQ(j["teacher"]["teacher"], "alp_gmm");  // the file's teacher
       ++dumps;
     }
   }
