@@ -1,6 +1,7 @@
 // `cradle illustrate --env reach|standup|selfbody|catch [--train_for N] [--test_for M]
 // [--algorithm PPO|SAC|TD3|DDPG|A2C] [--save_every K] [--save_model NAME] [--load_model PATH]
-// [--use_muscles] [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]`: the
+// [--use_muscles] [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]
+// [--task-space FILE.yml [--teacher T]]`: the
 // reference's illustrations.py. Trains a policy on a MIMo sample env (checkpoints
 // models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv, learning-curve PNGs),
 // then runs test_for steps with it (or with random actions when there is no model), optionally
@@ -22,6 +23,7 @@
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/jsonl.h"
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
 #include "eval/figures.h"
@@ -30,6 +32,7 @@
 #include "learn/registry.h"
 #include "learn/vector_env.h"
 #include "train/loop.h"
+#include "train/task_space.h"
 
 namespace cradle::apps {
 namespace {
@@ -53,6 +56,7 @@ struct IllustrateOptions {
   int envs = 1;
   std::uint64_t seed = 0;
   std::vector<std::string> hp;
+  std::string task_space, teacher;  // a curriculum (docs/curricula.md)
 };
 
 // The learner's name for a reference algorithm name; HER is refused.
@@ -145,11 +149,25 @@ void run(const IllustrateOptions& o) {
   env_options.palm_up = o.palm_up;
   const auto assets = envs::make_sample_assets(id, env_options);
 
+  // A curriculum: one teacher sets every training env's task options before its resets.
+  if (!o.teacher.empty() && o.task_space.empty())
+    throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
+  std::optional<train::CurriculumSpec> spec;
+  std::shared_ptr<teach::TeacherController> curriculum;
+  if (!o.task_space.empty()) {
+    spec = train::load_task_space(o.task_space);
+    if (!o.teacher.empty()) spec->teacher = o.teacher;
+    curriculum = train::make_controller(*spec, o.seed);
+  }
+
   // The learner trains on a vector of envs sharing the compiled scene.
   std::unique_ptr<learn::ThreadedVecEnv> vec = std::make_unique<learn::ThreadedVecEnv>(
       o.envs,
       [&](int i) -> std::unique_ptr<envs::Env> {
-        return envs::make_sample_env(assets, learn::ThreadedVecEnv::env_seed(o.seed, i));
+        auto env = envs::make_sample_env(assets, learn::ThreadedVecEnv::env_seed(o.seed, i));
+        if (!curriculum) return env;
+        return std::make_unique<train::CurriculumEnv>(std::move(env), curriculum,
+                                                      spec->env_options);
       },
       o.envs);
   std::unique_ptr<learn::Learner> learner;
@@ -168,6 +186,9 @@ void run(const IllustrateOptions& o) {
     };
     learner = learn::make_learner(algorithm, *vec, lo);
     if (!o.load_model.empty()) learner->load(o.load_model);
+    if (curriculum)  // SPDL values its tasks with the student's value function
+      curriculum->teacher().set_value_estimator(train::learner_value_estimator(
+          [&learner]() -> learn::Learner& { return *learner; }, vec->observation_space()));
   }
 
   // Training: checkpoints model_<k>.ckpt after every save_every steps, progress.csv per update.
@@ -224,6 +245,24 @@ void run(const IllustrateOptions& o) {
     train::run_loop(*learner, {.total_steps = total, .report = report});
     if (learner->steps() > saved_at) {
       learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
+    }
+    // The curriculum's book: every training episode's task and outcome, then the teacher's dump.
+    if (curriculum) {
+      JsonlWriter book(dir / "teacher.jsonl", /*append=*/false);
+      for (const teach::EpisodeRecord& e : curriculum->take_episodes())
+        book.write({{"kind", "train"},
+                    {"episode", e.episode},
+                    {"env_steps", e.env_steps},
+                    {"task", e.task},
+                    {"return", e.ret},
+                    {"length", e.length},
+                    {"success", e.success}});
+      book.write({{"kind", "dump"},
+                  {"env_steps", curriculum->env_steps()},
+                  {"teacher", curriculum->teacher_dump()}});
+      book.flush();
+      std::printf("curriculum: %ld episodes booked in %s\n", curriculum->episodes(),
+                  (dir / "teacher.jsonl").c_str());
     }
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
@@ -337,6 +376,10 @@ void register_illustrate(CLI::App& app) {
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--seed", o->seed, "Seed of the envs and the learner")->check(kSeed);
   cmd->add_option("--hp", o->hp, "Hyperparameter override name=value (repeatable)");
+  cmd->add_option(
+      "--task-space", o->task_space,
+      "Curriculum: task-space YAML whose teacher sets the training envs' reset options");
+  cmd->add_option("--teacher", o->teacher, "Curriculum teacher (overrides the file's)");
   cmd->callback([o] { run(*o); });
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <string_view>
 
@@ -123,9 +124,30 @@ void BabyBenchEnv::set_reset_options(const ResetOptions& options) {
       start_posture_range_ = value;
       continue;
     }
+    // A curriculum's reach distance: the cubes stack this far from MIMo (cubes scene only).
+    if (name == "cube_distance") {
+      const mjModel* m = model();
+      mimo_body_ = mj_name2id(m, mjOBJ_BODY, "mimo_location");
+      cube_qpos_.clear();
+      for (const char* cube : {"red_cube", "yellow_cube", "blue_cube"}) {
+        const int b = mj_name2id(m, mjOBJ_BODY, cube);
+        if (b >= 0 && m->body_jntnum[b] == 1)
+          cube_qpos_.push_back(m->jnt_qposadr[m->body_jntadr[b]]);
+      }
+      if (mimo_body_ < 0 || cube_qpos_.size() != 3) {
+        throw UserError("reset option cube_distance needs the cubes scene (scene: cubes)");
+      }
+      if (!(value >= 0.1 && value <= 0.8)) {
+        throw UserError("reset option cube_distance must be in [0.1, 0.8] m, not " +
+                        std::to_string(value));
+      }
+      cube_distance_ = value;
+      continue;
+    }
     if (name != "randomize_start") {
       throw UserError("reset option '" + name +
-                      "' is not a BabyBench one (expected randomize_start or start_posture_range)");
+                      "' is not a BabyBench one (expected randomize_start, start_posture_range or "
+                      "cube_distance)");
     }
     if (value != 0 && value != 1) {
       throw UserError("reset option randomize_start must be 0 or 1, not " + std::to_string(value));
@@ -184,6 +206,18 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
       q = r == 1.0 ? rng_.uniform(lo, hi) : rng_.uniform(q + r * (lo - q), q + r * (hi - q));
     }
     mj_forward(m, d);
+  }
+  // The cubes moved together along the line from MIMo's root to the red cube.
+  if (cube_distance_ > 0) {
+    mjData* d = sim.data();
+    const double* root = d->xpos + 3 * mimo_body_;
+    const double dx = d->qpos[cube_qpos_[0]] - root[0], dy = d->qpos[cube_qpos_[0] + 1] - root[1];
+    const double shift = cube_distance_ / std::max(std::hypot(dx, dy), 1e-9) - 1;
+    for (int q : cube_qpos_) {
+      d->qpos[q] += shift * dx;
+      d->qpos[q + 1] += shift * dy;
+    }
+    mj_forward(model(), d);
   }
 
   // Random start: a few random actions drawn from the env's own (seeded) generator.

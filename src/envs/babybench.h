@@ -129,7 +129,12 @@ class BabyBenchEnv final : public Env {
   std::vector<double> random_action_;
   bool randomize_start_ = false;
   double start_posture_range_ = 0;  // [0, 1]: share of each joint's range drawn around the start
-  std::vector<int> free_joints_;    // robot:* joints no active joint equality holds
+  // Reset option cube_distance (cubes scene): the stacked cubes' horizontal distance from MIMo's
+  // root (m); <= 0: where the scene puts them.
+  double cube_distance_ = 0;
+  int mimo_body_ = -1;
+  std::vector<int> cube_qpos_;    // red, yellow and blue cube's free-joint qpos addresses
+  std::vector<int> free_joints_;  // robot:* joints no active joint equality holds
   int steps_ = 0;
 };
 

@@ -1,6 +1,7 @@
 // The BabyBench behaviours by name; "none" only counts steps.
 #include <limits>
 
+#include "core/error.h"
 #include "envs/hand_regard.h"
 #include "envs/self_touch.h"
 #include "envs/task.h"
@@ -8,6 +9,12 @@
 namespace cradle::envs {
 
 double Task::score(const Info&, int) const { return std::numeric_limits<double>::quiet_NaN(); }
+
+void Task::set_reset_options(const ResetOptions& options) {
+  if (!options.empty()) {
+    throw UserError("reset option '" + options.begin()->first + "' is not one this task takes");
+  }
+}
 
 namespace {
 

@@ -76,6 +76,9 @@ class Task {
   }
   // After each env step's observation; writes the info and returns the reward.
   virtual double after_step(const MimoCore& core, Info& info) = 0;
+  // Options of the task's later episode starts (a curriculum's task parameters, e.g. reach's
+  // ball offset); UserError for an option it does not take (by default: any).
+  virtual void set_reset_options(const ResetOptions& options);
   // Score of an episode of `steps` env steps from its info (NaN: the task measures nothing).
   virtual double score(const Info& info, int steps) const;
   // What an evaluation of the task shows (default: two cameras, nothing else).

@@ -51,6 +51,7 @@ constexpr Range kRanges[] = {
     {"target_entropy", -1e6, 1e6},
     {"n_critics", 1, 100},
     {"report_every", 1, 1e11},
+    {"shared_layers", 1, 65536},
     {"pi_layers", 1, 65536},
     {"vf_layers", 1, 65536},
     {"qf_layers", 1, 65536},

@@ -101,6 +101,12 @@ class Learner {
   // update the observation statistics.
   virtual void act(const envs::ObservationBuffers& observation, std::span<double> action,
                    bool deterministic) = 0;
+  // The expected discounted return from one observation (curriculum teachers' estimate, SPDL):
+  // PPO's value head, SAC's min_i Q_i(s, tanh(mean(s))); NaN for a learner without one. Does not
+  // update the observation statistics.
+  virtual double value(const envs::ObservationBuffers& /*observation*/) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
   // Every hyperparameter as "name = value" lines (what checkpoints store).
   virtual std::string config_text() const = 0;
   // A hash of the trained parameters (learn/grad_sync.h tensor_hash), equal on every rank of a

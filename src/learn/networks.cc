@@ -13,6 +13,8 @@
 namespace cradle::learn {
 
 void PolicyConfig::bind(Hyperparameters& table) {
+  table.add("shared_layers", &shared_layers,
+            "hidden sizes shared by policy and value, e.g. 400,300 (empty: none)");
   table.add("pi_layers", &pi_layers, "policy MLP hidden sizes, e.g. 64,64 (SB3 net_arch pi)");
   table.add("vf_layers", &vf_layers, "value MLP hidden sizes, e.g. 64,64 (SB3 net_arch vf)");
   table.add("activation", &activation, "hidden activation: tanh or relu (SB3 activation_fn)");
@@ -194,7 +196,14 @@ GaussianActorCriticImpl::GaussianActorCriticImpl(const ObsShape& shape, int acti
                                                  const PolicyConfig& config,
                                                  at::Generator& generator) {
   encoder_ = register_module("encoder", MultiInputEncoder(shape, config.cnn_features));
-  const int features = encoder_->output_size();
+  int features = encoder_->output_size();
+  // The shared trunk only when asked for: without one the parameters (and a seed's draws) stay
+  // those of separate networks.
+  if (!config.shared_layers.empty()) {
+    shared_net_ =
+        register_module("shared_net", make_mlp(features, config.shared_layers, config.activation));
+    features = config.shared_layers.back();
+  }
   pi_net_ = register_module("pi_net", make_mlp(features, config.pi_layers, config.activation));
   vf_net_ = register_module("vf_net", make_mlp(features, config.vf_layers, config.activation));
   const int pi_out = config.pi_layers.empty() ? features : config.pi_layers.back();
@@ -207,20 +216,32 @@ GaussianActorCriticImpl::GaussianActorCriticImpl(const ObsShape& shape, int acti
   // state-independent first policy), 1 for the value.
   const double hidden_gain = std::sqrt(2.0);
   init_layers(*encoder_, hidden_gain, config.ortho_init, generator);
+  if (shared_net_) init_layers(*shared_net_, hidden_gain, config.ortho_init, generator);
   init_layers(*pi_net_, hidden_gain, config.ortho_init, generator);
   init_layers(*vf_net_, hidden_gain, config.ortho_init, generator);
   init_layers(*action_mean_, 0.01, config.ortho_init, generator);
   init_layers(*value_head_, 1.0, config.ortho_init, generator);
 }
 
+namespace {
+// An MLP of make_mlp; one without layers passes its input through (a shared trunk alone).
+torch::Tensor through(torch::nn::Sequential& mlp, const torch::Tensor& x) {
+  return mlp->is_empty() ? x : mlp->forward(x);
+}
+}  // namespace
+
+torch::Tensor GaussianActorCriticImpl::features(const ObsBatch& observation) {
+  const torch::Tensor encoded = encoder_->forward(observation);
+  return shared_net_ ? shared_net_->forward(encoded) : encoded;
+}
+
 GaussianActorCriticImpl::Output GaussianActorCriticImpl::forward(const ObsBatch& observation) {
-  const torch::Tensor features = encoder_->forward(observation);
-  return {action_mean_(pi_net_->forward(features)),
-          value_head_(vf_net_->forward(features)).squeeze(1)};
+  const torch::Tensor h = features(observation);
+  return {action_mean_(through(pi_net_, h)), value_head_(through(vf_net_, h)).squeeze(1)};
 }
 
 torch::Tensor GaussianActorCriticImpl::value(const ObsBatch& observation) {
-  return value_head_(vf_net_->forward(encoder_->forward(observation))).squeeze(1);
+  return value_head_(through(vf_net_, features(observation))).squeeze(1);
 }
 
 torch::Tensor GaussianActorCriticImpl::log_prob(const torch::Tensor& mean,
@@ -234,6 +255,13 @@ torch::Tensor GaussianActorCriticImpl::log_prob(const torch::Tensor& mean,
 torch::Tensor GaussianActorCriticImpl::entropy() const {
   // H = sum over dimensions of (1 + log(2 pi)) / 2 + log sigma.
   return (0.5 + 0.5 * std::log(2.0 * std::numbers::pi) + log_std_).sum();
+}
+
+double state_value(ObservationPipeline& pipeline, GaussianActorCritic& policy,
+                   const envs::ObservationBuffers& observation, ObsBatch& scratch) {
+  torch::NoGradGuard no_grad;
+  pipeline.process(observation, scratch);
+  return policy->value(scratch)[0].item<double>();
 }
 
 }  // namespace cradle::learn

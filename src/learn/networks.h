@@ -2,9 +2,9 @@
 // - MultiInputEncoder (SB3 CombinedExtractor): the preprocessed observation vector passes
 //   through as is; each eye image goes through its own NatureCNN; the results are concatenated.
 // - make_mlp: fully connected hidden layers with an activation after each.
-// - GaussianActorCritic (SB3 ActorCriticPolicy for Box actions): a shared encoder, separate
-//   policy and value MLPs (64-64 tanh), a linear action mean, a linear value and a
-//   state-independent log standard deviation.
+// - GaussianActorCritic (SB3 ActorCriticPolicy for Box actions): a shared encoder, an optional
+//   shared trunk, separate policy and value MLPs (64-64 tanh), a linear action mean, a linear
+//   value and a state-independent log standard deviation.
 // Off-policy learners can build deterministic actors and Q(obs, action) networks from the same
 // parts: an encoder, make_mlp over [features, action], and init_layers.
 //
@@ -25,6 +25,9 @@
 namespace cradle::learn {
 
 struct PolicyConfig {
+  // Hidden layers shared by policy and value before their own (SB3 net_arch's shared part,
+  // Baselines' ppo2 "mlp" trunk); empty: separate networks.
+  std::vector<int> shared_layers;
   std::vector<int> pi_layers{64, 64};  // policy MLP hidden sizes (SB3 net_arch pi)
   std::vector<int> vf_layers{64, 64};  // value MLP hidden sizes (SB3 net_arch vf)
   std::string activation = "tanh";     // "tanh" or "relu" (SB3 activation_fn, nn.Tanh)
@@ -133,11 +136,19 @@ class GaussianActorCriticImpl : public torch::nn::Module {
   torch::Tensor entropy() const;
 
  private:
+  // The encoder's features through the shared trunk (when there is one).
+  torch::Tensor features(const ObsBatch& observation);
+
   MultiInputEncoder encoder_{nullptr};
-  torch::nn::Sequential pi_net_{nullptr}, vf_net_{nullptr};
+  torch::nn::Sequential shared_net_{nullptr}, pi_net_{nullptr}, vf_net_{nullptr};
   torch::nn::Linear action_mean_{nullptr}, value_head_{nullptr};
   torch::Tensor log_std_;
 };
 TORCH_MODULE(GaussianActorCritic);
+
+// V(s) of one observation as the policy sees it (normalised by `pipeline`, whose statistics do
+// not change), through `scratch`, a one-row batch (PPO's and A2C's Learner::value).
+double state_value(ObservationPipeline& pipeline, GaussianActorCritic& policy,
+                   const envs::ObservationBuffers& observation, ObsBatch& scratch);
 
 }  // namespace cradle::learn

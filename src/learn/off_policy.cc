@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -444,6 +445,13 @@ void OffPolicyLearner::act(const envs::ObservationBuffers& observation, std::spa
   torch::NoGradGuard no_grad;
   pipeline_.process(observation, scratch_);
   unscale_actions(policy_action(scratch_, deterministic), env_.action_space(), action);
+}
+
+double OffPolicyLearner::value(const envs::ObservationBuffers& observation) {
+  torch::NoGradGuard no_grad;
+  pipeline_.process(observation, scratch_);
+  const torch::Tensor v = state_value(scratch_);
+  return v.defined() ? v[0].item<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -177,6 +177,7 @@ class OffPolicyLearner : public Learner {
   void update(int count);
   // Floats of the preprocessed observation vector the networks read (pooled touch included).
   int observation_size() const { return pipeline_.shape().vector_size; }
+  double value(const envs::ObservationBuffers& observation) override;
 
  protected:
   // Throws UserError for an action space without finite bounds or a replay buffer too large
@@ -188,6 +189,8 @@ class OffPolicyLearner : public Learner {
   // Actions in [-1, 1] for the current observations: the behaviour policy (deterministic:
   // the policy's best guess, for evaluation). [rows, action_size].
   virtual torch::Tensor policy_action(const ObsBatch& observation, bool deterministic) = 0;
+  // The value of each observation [rows] (Learner::value); undefined: the algorithm has none.
+  virtual torch::Tensor state_value(const ObsBatch& /*observation*/) { return {}; }
   // One gradient step on a minibatch (observations already normalised). `update` counts the
   // updates since the start of training, this one included (TD3's delay).
   virtual void train(const ReplayBuffer::Sample& batch, long update) = 0;

@@ -160,6 +160,11 @@ class OnPolicyLearner : public Learner {
                  deterministic);
   }
 
+  // The value head's estimate of a state (the Self-Paced teacher's value estimator).
+  double value(const envs::ObservationBuffers& observation) override {
+    return state_value(pipeline_, policy_, observation, scratch_);
+  }
+
  protected:
   OnPolicyLearner(std::string algorithm, VecEnv& env, const LearnerOptions& options,
                   const OnPolicyLoop& loop, const ObservationConfig& observation,

@@ -208,6 +208,11 @@ class Sac final : public OffPolicyLearner {
             }};
   }
 
+  // Q(s, pi(s)) at the deterministic action, the minimum over the critics (as the targets).
+  torch::Tensor state_value(const ObsBatch& observation) override {
+    return std::get<0>(critic_->forward(observation, actor_->mean_action(observation)).min(0));
+  }
+
   void train(const ReplayBuffer::Sample& batch, long update) override {
     // Reparameterised actions for s, and the temperature step on them.
     auto [pi_actions, log_pi] = actor_->sample(batch.observations, generator());

@@ -106,4 +106,43 @@ void CurriculumEnv::flatten(std::vector<float>& out) const {
   out.resize(n);
 }
 
+teach::ValueEstimator learner_value_estimator(std::function<learn::Learner&()> learner,
+                                              const DictSpace& space) {
+  return [learner = std::move(learner), space](const std::vector<std::vector<float>>& states) {
+    envs::ObservationBuffers obs(space);
+    // The flat size: every non-image key.
+    std::size_t total = 0;
+    for (int k = 0; k < obs.count(); ++k) {
+      const DType t = space.entries[k].second.dtype;
+      if (t != DType::kUInt8) total += t == DType::kFloat64 ? obs.f64(k).size() : obs.f32(k).size();
+    }
+    std::vector<float> values;
+    values.reserve(states.size());
+    for (const std::vector<float>& state : states) {
+      if (state.size() != total) {
+        throw UserError("value estimator: a state of " + std::to_string(state.size()) +
+                        " values, expected the env's " + std::to_string(total) +
+                        " non-image observation values");
+      }
+      // The flat state back into the buffers, key by key as flatten() wrote it.
+      std::size_t n = 0;
+      for (int k = 0; k < obs.count(); ++k) {
+        const DType t = space.entries[k].second.dtype;
+        if (t == DType::kFloat64) {
+          for (double& v : obs.f64(k)) v = state[n++];
+        } else if (t != DType::kUInt8) {
+          for (float& v : obs.f32(k)) v = state[n++];
+        }
+      }
+      const double v = learner().value(obs);
+      if (std::isnan(v)) {
+        throw UserError("Self-Paced needs a student with a value function (ppo or sac), not " +
+                        std::string(learner().algorithm()));
+      }
+      values.push_back(static_cast<float>(v));
+    }
+    return values;
+  };
+}
+
 }  // namespace cradle::train

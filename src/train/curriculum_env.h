@@ -5,12 +5,14 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
 
 #include "envs/env.h"
+#include "learn/learner.h"
 #include "teach/controller.h"
 
 namespace cradle::train {
@@ -66,5 +68,13 @@ class CurriculumEnv : public envs::Env {
   int length_ = 0, success_slot_ = -1;
   bool in_episode_ = false;
 };
+
+// SPDL's value estimator (Teacher::set_value_estimator) over a student's Learner::value: each
+// state in CurriculumEnv's flat layout (the non-image keys of `space` in order; image keys stay
+// zero) goes back into observation buffers and is valued. `learner` is asked at every call, so
+// a replaced student (criterion 3) is the one valued. UserError for a state of the wrong size or
+// a learner without a value function.
+teach::ValueEstimator learner_value_estimator(std::function<learn::Learner&()> learner,
+                                              const DictSpace& space);
 
 }  // namespace cradle::train

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <span>
 #include <sstream>
 
 #include "core/error.h"
@@ -24,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 const char* const kProgressHeader =
     "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,pct_mastered,"
-    "mean_train_return";
+    "mean_train_return,gradient_steps,teacher_s";
 const char* const kTestHeader = "evaluation,env_steps,task_index,return,mastered";
 // The files a checkpoint records the size of (cut back to it on resume).
 const char* const kLogs[] = {"progress.csv", "test_returns.csv", "teacher.jsonl"};
@@ -94,6 +95,45 @@ void cut_back(const fs::path& file, std::uintmax_t size) {
             << "\n";
 }
 
+// VecNormalize's return normalisation (Baselines' ppo2 as TeachMyAgent runs it): each env keeps
+// its discounted return ret = gamma ret + r (zeroed when an episode ends), a running variance of
+// ret over every step, and the learner trains on r / sqrt(var + 1e-8) clipped to +-10. Autoreset
+// steps (no transition) neither add to ret nor to the statistics. Its statistics start afresh in
+// every process (a resumed run does not restore them).
+class ReturnNormalizer {
+ public:
+  explicit ReturnNormalizer(double gamma) : gamma_(gamma) {}
+  void operator()(const learn::VecEnv& env, std::span<const double>, std::span<double> rewards) {
+    const int n = env.num_envs();
+    if (ret_.empty()) {
+      ret_.assign(n, 0.0);
+      ended_.assign(n, 0);
+    }
+    for (int i = 0; i < n; ++i) {
+      if (ended_[i]) {  // this step only reset the env
+        ended_[i] = 0;
+        continue;
+      }
+      ret_[i] = gamma_ * ret_[i] + rewards[i];
+      // Running mean and variance (Chan et al.'s merge of one sample), count starting at 1e-4.
+      const double delta = ret_[i] - mean_, total = count_ + 1;
+      mean_ += delta / total;
+      var_ = (var_ * count_ + delta * delta * count_ / total) / total;
+      count_ = total;
+      rewards[i] = std::clamp(rewards[i] / std::sqrt(var_ + 1e-8), -10.0, 10.0);
+      if (env.terminated()[i] || env.truncated()[i]) {
+        ret_[i] = 0;
+        ended_[i] = 1;
+      }
+    }
+  }
+
+ private:
+  double gamma_, mean_ = 0, var_ = 1, count_ = 1e-4;
+  std::vector<double> ret_;
+  std::vector<std::uint8_t> ended_;
+};
+
 // The teacher's build: the registry's setup from the run's options and the env's facts.
 std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const StudentRunOptions& o,
                                                  const teach::DimensionShuffle* shuffle) {
@@ -116,6 +156,8 @@ std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const St
 
 }  // namespace
 
+learn::RewardHook return_normalizer(double gamma) { return ReturnNormalizer(gamma); }
+
 std::map<std::string, std::string> student_preset(const std::string& student, long total_steps) {
   // SpinningUp SAC as TeachMyAgent runs it (spec §4.1).
   if (student == "sac") {
@@ -134,15 +176,25 @@ std::map<std::string, std::string> student_preset(const std::string& student, lo
   }
   // Baselines ppo2 as criterion 5 runs it (spec §4.2).
   if (student == "ppo") {
-    return {{"pi_layers", "400,300"},    {"vf_layers", "400,300"},
-            {"activation", "tanh"},      {"ortho_init", "true"},
-            {"log_std_init", "0"},       {"n_steps", "20000"},
-            {"batch_size", "1000"},      {"n_epochs", "5"},
-            {"learning_rate", "0.0003"}, {"clip_range", "0.2"},
-            {"gae_lambda", "0.95"},      {"gamma", "0.99"},
-            {"vf_coef", "0.5"},          {"ent_coef", "0"},
-            {"max_grad_norm", "0.5"},    {"normalize_observations", "true"},
-            {"clip_observations", "10"}};
+    return {{"shared_layers", "400,300"},
+            {"pi_layers", ""},
+            {"vf_layers", ""},
+            {"activation", "tanh"},
+            {"ortho_init", "true"},
+            {"log_std_init", "0"},
+            {"n_steps", "20000"},
+            {"batch_size", "1000"},
+            {"n_epochs", "5"},
+            {"learning_rate", "0.0003"},
+            {"clip_range", "0.2"},
+            {"gae_lambda", "0.95"},
+            {"gamma", "0.99"},
+            {"vf_coef", "0.5"},
+            {"ent_coef", "0"},
+            {"max_grad_norm", "0.5"},
+            {"normalize_observations", "true"},
+            {"clip_observations", "10"},
+            {"normalize_returns", "true"}};
   }
   throw UserError("--student '" + student + "' (expected sac or ppo)");
 }
@@ -209,12 +261,33 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   // The student; a reset gives a fresh one (criterion 3) with its own seed.
   long offset = 0;
   int student_resets = 0;
+  // normalize_returns is the run's (a reward hook), not the learner's.
+  std::map<std::string, std::string> learner_hp = hyperparameters;
+  bool normalize_returns = false;
+  if (const auto it = learner_hp.find("normalize_returns"); it != learner_hp.end()) {
+    if (it->second != "true" && it->second != "false")
+      throw UserError("--hp normalize_returns=" + it->second + " (expected true or false)");
+    normalize_returns = it->second == "true";
+    learner_hp.erase(it);
+  }
+  double gamma = 0.99;
+  if (learner_hp.contains("gamma")) {
+    try {
+      gamma = std::stod(learner_hp.at("gamma"));
+    } catch (const std::exception&) {
+      // The learner names the bad value.
+    }
+  }
   auto make_student = [&] {
     learn::LearnerOptions lo{.seed = o.seed + 7919 * static_cast<std::uint64_t>(student_resets),
-                             .hyperparameters = hyperparameters};
+                             .hyperparameters = learner_hp};
+    if (normalize_returns) lo.reward_hook = return_normalizer(gamma);
     return learn::make_learner(o.student, vec, lo);
   };
   std::unique_ptr<learn::Learner> learner = make_student();
+  // SPDL values its tasks with the student's value function (the current student after a reset).
+  controller->teacher().set_value_estimator(learner_value_estimator(
+      [&learner]() -> learn::Learner& { return *learner; }, vec.observation_space()));
 
   // Resume: the same arguments (but the resumable ones), the checkpoint's state.
   nlohmann::json state;
@@ -359,7 +432,8 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     progress << evaluation << "," << steps << "," << controller->episodes() << "," << cell(wall)
              << "," << cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << "," << cell(mean)
              << "," << cell(std::sqrt(var)) << "," << cell(pct) << ","
-             << cell(train_returns ? train_return_sum / train_returns : std::nan("")) << "\n";
+             << cell(train_returns ? train_return_sum / train_returns : std::nan("")) << ","
+             << cell(updates_done) << "," << cell(train_env->teacher_seconds()) << "\n";
     train_return_sum = 0;
     train_returns = 0;
     teacher_log.write(

@@ -262,6 +262,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     }
   };
   std::unique_ptr<Learner> learner = learn::make_learner(algorithm, *vec, lo);
+  // SPDL values its tasks with the student's value function.
+  if (curriculum)
+    curriculum->teacher().set_value_estimator(learner_value_estimator(
+        [&learner]() -> Learner& { return *learner; }, vec->observation_space()));
   if (options.resume) {
     learner->load(latest);
     load_run_state(latest, reward.get());

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "fixture.h"
 
@@ -35,7 +36,8 @@ TEST(Illustrate, BadFlagsAreOneLineErrors) {
        {"--env reach --algorithm HER", "--env fly --algorithm PPO", "--env reach --algorithm XYZ",
         "--env reach --algorithm PPO --load_model /no/such.ckpt",
         "--env reach --algorithm PPO --save_every 0", "--env reach --algorithm PPO --palm_up",
-        "--env standup --algorithm PPO --jitter", "--env reach --train_for 10"}) {
+        "--env standup --algorithm PPO --jitter", "--env reach --train_for 10",
+        "--env reach --algorithm PPO --teacher Random"}) {
     const CliResult r = cradle_in(dir, std::string("illustrate ") + args);
     EXPECT_EQ(r.status, 1) << args;
     EXPECT_EQ(lines(r.out), 1) << args << ": " << r.out;
@@ -84,6 +86,36 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   fs::remove_all(dir);
 }
 
+// A curriculum on catch (the shipped file): the teacher's throws reach the training envs and every
+// training episode is booked with its task inside the file's box.
+TEST(Illustrate, CatchCurriculumBooksEveryTrainingEpisode) {
+  const fs::path dir = cradle::test::fresh_dir("illustrate_curriculum");
+  const std::string file = std::string(CRADLE_SOURCE_DIR) + "/configs/curricula/mimo_catch.yml";
+  const CliResult r = cradle_in(dir,
+                                "illustrate --env catch --algorithm PPO --train_for 256 "
+                                "--test_for 0 --save_model cur --hp n_steps=128 --hp batch_size=64 "
+                                "--task-space " +
+                                    file);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream book(dir / "models" / "catch" / "cur" / "teacher.jsonl");
+  int train = 0, dumps = 0;
+  for (std::string line; std::getline(book, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j["kind"] == "train") {
+      ++train;
+      const auto task = j["task"].get<std::vector<double>>();
+      ASSERT_EQ(task.size(), 3u);
+      EXPECT_GE(task[1], 0.0);  // ball_speed in [0, 2]
+      EXPECT_LE(task[1], 2.0);
+    } else {
+      EXPECT_EQ(j["teacher"]["teacher"], "alp_gmm");  // the file's teacher
+      ++dumps;
+    }
+  }
+  EXPECT_GT(train, 2);  // a dropped ball ends an episode within a few dozen steps
+  EXPECT_EQ(dumps, 1);
+}
+
 // The reference's documented call without --algorithm and without a model tests random actions,
 // the same (seeded) episodes as with an algorithm named but no model.
 TEST(Illustrate, NoAlgorithmAndNoModelTestsRandomActions) {
@@ -91,8 +123,9 @@ TEST(Illustrate, NoAlgorithmAndNoModelTestsRandomActions) {
   const CliResult r = cradle_in(dir, "illustrate --env catch --test_for 200 --seed 4");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("with random actions"), std::string::npos) << r.out;
-  const CliResult named = cradle_in(dir, "illustrate --env catch --test_for 200 --seed 4 "
-                                         "--algorithm SAC");
+  const CliResult named = cradle_in(dir,
+                                    "illustrate --env catch --test_for 200 --seed 4 "
+                                    "--algorithm SAC");
   ASSERT_EQ(named.status, 0) << named.out;
   EXPECT_EQ(r.out, named.out);
   EXPECT_NE(r.out.find("test episodes: success rate"), std::string::npos) << r.out;

@@ -40,5 +40,42 @@ TEST(UpdateThreads, NegativeIsAUserError) {
   EXPECT_THROW(apply_torch_options({.update_threads = -1}), UserError);
 }
 
+// Parameters of a module, counted.
+long count_parameters(torch::nn::Module& m) {
+  long n = 0;
+  for (const auto& p : m.parameters()) n += p.numel();
+  return n;
+}
+
+TEST(GaussianActorCritic, SharedTrunkFeedsPolicyAndValue) {
+  const ObsShape shape{.vector_size = 5};
+  auto generator = at::make_generator<at::CPUGeneratorImpl>(1);
+  // Baselines' ppo2 "mlp": one trunk of 8, 6; the heads read it directly.
+  PolicyConfig shared;
+  shared.shared_layers = {8, 6};
+  shared.pi_layers = {};
+  shared.vf_layers = {};
+  GaussianActorCritic net(shape, 2, shared, generator);
+  // Trunk (5*8+8 + 8*6+6), action mean (6*2+2), value (6+1), log std 2.
+  EXPECT_EQ(count_parameters(*net), 48 + 54 + 14 + 7 + 2);
+  // Both the action mean and the value reach back into the trunk's first layer.
+  ObsBatch batch = ObsBatch::zeros(shape, 3);
+  batch.vector = torch::randn({3, 5}, generator);
+  const auto out = net->forward(batch);
+  const torch::Tensor first = net->named_parameters()["shared_net.0.weight"];
+  const auto grad_of = [&](const torch::Tensor& y) {
+    return torch::autograd::grad({y.sum()}, {first}, {}, true)[0].abs().sum().item<double>();
+  };
+  EXPECT_GT(grad_of(out.mean), 0.0);
+  EXPECT_GT(grad_of(out.value), 0.0);
+  EXPECT_TRUE(torch::allclose(net->value(batch), out.value));
+  // Without a trunk (the default) nothing is added: separate 64-64 networks as before.
+  GaussianActorCritic separate(shape, 2, PolicyConfig{}, generator);
+  EXPECT_EQ(count_parameters(*separate),
+            2 * (5 * 64 + 64 + 64 * 64 + 64) + (64 * 2 + 2) + (64 + 1) + 2);
+  for (const auto& item : separate->named_parameters())
+    EXPECT_EQ(item.key().find("shared_net"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace cradle::learn

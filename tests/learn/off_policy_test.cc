@@ -390,6 +390,24 @@ TEST(Sac, TrainsAtEpisodeEndsWithEpisodeTrainFreq) {
                UserError);
 }
 
+TEST(Sac, ValueIsTheCriticAtTheDeterministicActionAndRises) {
+  // CartPole pays 1 per step: min_i Q_i(s, tanh(mean(s))) of a start state grows with training.
+  auto env = testing::make_cartpoles(1, 100);
+  auto sac = make_learner("sac", *env,
+                          {.seed = 2,
+                           .hyperparameters = {{"learning_starts", "100"},
+                                               {"batch_size", "32"},
+                                               {"pi_layers", "32"},
+                                               {"qf_layers", "32"}}});
+  env->reset(5);
+  const envs::ObservationBuffers start = env->observation(0);
+  const double before = sac->value(start);
+  EXPECT_LT(std::fabs(before), 2.0);
+  EXPECT_EQ(sac->value(start), before);
+  sac->learn(1500, [](const TrainStats&) { return true; });
+  EXPECT_GT(sac->value(start), before + 3.0);
+}
+
 TEST(Sac, DeterministicGivenTheSeed) {
   auto env_a = testing::make_cartpoles(2, 30);
   auto env_b = testing::make_cartpoles(2, 30);

@@ -103,6 +103,23 @@ TEST(Ppo, LearnsCartPole) {
   }
 }
 
+TEST(Ppo, ValueHeadRisesAsItLearnsTheReturn) {
+  // CartPole pays 1 per step: the value of a start state grows from about 0 toward the
+  // discounted episode length as the value head trains (SPDL's estimate of a task).
+  auto env = testing::make_cartpoles(2, kMaxSteps);
+  auto learner = make_learner(
+      "ppo", *env, {.seed = 3, .hyperparameters = {{"n_steps", "256"}, {"shared_layers", "32"}}});
+  const std::vector<envs::ObservationBuffers> probes = probe_observations(false);
+  const double before = learner->value(probes[0]);
+  EXPECT_LT(std::fabs(before), 2.0);
+  EXPECT_EQ(learner->value(probes[0]), before);  // no statistics change in between
+  train(*learner, 5'000);
+  const double after = learner->value(probes[0]);
+  EXPECT_GT(after, before + 3.0);
+  // Algorithms without a value function say so with NaN.
+  EXPECT_TRUE(std::isnan(make_learner("td3", *env, {})->value(probes[0])));
+}
+
 TEST(A2c, ImprovesOnCartPole) {
   const double baseline = random_return(200);
   auto env = testing::make_cartpoles(4, kMaxSteps);

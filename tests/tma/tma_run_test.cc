@@ -79,7 +79,7 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   ASSERT_EQ(progress.size(), 4u);
   EXPECT_EQ(progress[0],
             "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
-            "pct_mastered,mean_train_return");
+            "pct_mastered,mean_train_return,gradient_steps,teacher_s");
   EXPECT_EQ(cells(progress[1])[0], "0");
   EXPECT_EQ(cells(progress[1])[1], "0");
   EXPECT_EQ(cells(progress[3])[0], "2");
@@ -148,7 +148,7 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   const RunResult r = run_cradle(
       "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.001 "
       "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
-      "--hp batch_size=50 --hp pi_layers=16 --hp vf_layers=16 --out " +
+      "--hp batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --out " +
       dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
   const std::vector<std::string> progress = lines(dir / "progress.csv");

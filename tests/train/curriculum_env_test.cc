@@ -194,5 +194,95 @@ TEST(CurriculumEnv, RefusesATeachersParameterAsAnOption) {
   EXPECT_THROW(env.set_reset_options({{"gain", 1}}), UserError);
 }
 
+// A student whose value of an initial state is level * (1 + gain) (the Corridor's second
+// observation), level rising by `rise` at every valuation; NaN stands for no value function.
+class ValuedStudent final : public learn::Learner {
+ public:
+  explicit ValuedStudent(double rise) : rise_(rise) {}
+  std::string_view algorithm() const override { return "stub"; }
+  void learn(long, const learn::ProgressFn&) override {}
+  long steps() const override { return 0; }
+  void save(const std::filesystem::path&) const override {}
+  void load(const std::filesystem::path&) override {}
+  void act(const envs::ObservationBuffers&, std::span<double>, bool) override {}
+  std::string config_text() const override { return ""; }
+  double value(const envs::ObservationBuffers& obs) override {
+    ++valued;
+    level_ += rise_;
+    return level_ * (1.0 + obs.f64(0)[1]);
+  }
+  int valued = 0;
+
+ private:
+  double rise_, level_ = 0;
+};
+
+// The KLs to the target SPDL booked at each update, after `steps` Corridor steps under a student.
+std::vector<double> spdl_kls(learn::Learner& student, int steps) {
+  teach::SelfPacedParams p;
+  p.update_frequency = 200;
+  p.update_offset = 0;
+  p.zeta = 0.5;
+  p.initial_dist = teach::DiagGaussian{{2.f, 0.5f}, {0.05f, 0.01f}};  // short, poor episodes
+  auto controller = std::make_shared<teach::TeacherController>(
+      teach::make_self_paced_teacher({1.f, 0.f}, {10.f, 5.f}, 3, p),
+      teach::TaskSpace::from_json(
+          nlohmann::ordered_json::parse(R"({"length": [1, 10], "gain": [0, 5]})")),
+      teach::ControllerOptions{.test_set = {{1.f, 0.f}}});
+  auto corridor = std::make_unique<Corridor>();
+  const DictSpace space = corridor->observation_space();
+  controller->teacher().set_value_estimator(
+      learner_value_estimator([&student]() -> learn::Learner& { return student; }, space));
+  CurriculumEnv env(std::move(corridor), controller);
+  const std::vector<double> a = {0.0};
+  env.reset();
+  for (int i = 0; i < steps; ++i) {
+    const envs::StepResult r = env.step(a);
+    if (r.terminated || r.truncated) env.reset();
+  }
+  std::vector<double> kls;
+  const nlohmann::json dump = controller->teacher_dump();
+  for (const auto& h : dump.at("history")) kls.push_back(h.at("kl"));
+  return kls;
+}
+
+TEST(CurriculumEnv, SelfPacedMovesTowardTheTargetAsTheStudentsValueRises) {
+  // A student whose values rise: SPDL's distribution approaches the target (the whole box).
+  ValuedStudent rising(0.01);
+  const std::vector<double> moved = spdl_kls(rising, 2000);
+  ASSERT_EQ(moved.size(), 11u);   // the start and 10 updates
+  EXPECT_GT(rising.valued, 100);  // the initial states of the episodes were valued
+  // KL to the target shrinks update after update (6.3 -> 4.2 here; max_kl bounds each step).
+  int closer = 0;
+  for (std::size_t i = 1; i < moved.size(); ++i) closer += moved[i] < moved[i - 1];
+  EXPECT_GE(closer, 8);
+  EXPECT_LT(moved.back(), 0.75 * moved.front());
+  // A student that values nothing: no performance, no pull toward the target.
+  ValuedStudent flat(0.0);
+  const std::vector<double> still = spdl_kls(flat, 2000);
+  ASSERT_EQ(still.size(), 11u);
+  EXPECT_NEAR(still.back(), still.front(), 1e-6 * still.front());
+}
+
+TEST(CurriculumEnv, SelfPacedRefusesAStudentWithoutValue) {
+  // The base Learner::value is NaN: the first update says which students can serve.
+  class NoValue final : public learn::Learner {
+   public:
+    std::string_view algorithm() const override { return "td3"; }
+    void learn(long, const learn::ProgressFn&) override {}
+    long steps() const override { return 0; }
+    void save(const std::filesystem::path&) const override {}
+    void load(const std::filesystem::path&) override {}
+    void act(const envs::ObservationBuffers&, std::span<double>, bool) override {}
+    std::string config_text() const override { return ""; }
+  } student;
+  try {
+    spdl_kls(student, 400);
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("not td3"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace cradle::train

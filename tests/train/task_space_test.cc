@@ -8,6 +8,8 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "envs/babybench.h"
+#include "envs/mimo/sample_env.h"
 
 namespace cradle::train {
 namespace {
@@ -81,6 +83,102 @@ TEST(TaskSpaceFile, ShippedBabyBenchExampleLoads) {
   EXPECT_EQ(spec.space->dim_names(), std::vector<std::string>{"start_posture_range"});
   EXPECT_TRUE(std::isnan(spec.env_options.success_threshold));
   EXPECT_NO_THROW(make_controller(spec, 1));
+}
+
+// A shipped task-space file's spec and a controller seeded 3.
+std::pair<CurriculumSpec, std::shared_ptr<teach::TeacherController>> shipped(const char* name) {
+  CurriculumSpec spec =
+      load_task_space(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/curricula" / name);
+  auto controller = make_controller(spec, 3);
+  return {std::move(spec), std::move(controller)};
+}
+
+TEST(TaskSpaceFile, ReachFilePlacesTheBallWhereTheTeacherSays) {
+  auto [spec, controller] = shipped("mimo_reach.yml");
+  EXPECT_EQ(spec.space->dim_names(),
+            (std::vector<std::string>{"target_dx", "target_dy", "target_dz"}));
+  auto inner = envs::make_sample_env("MIMoReach-v0", {.vision_resolution = 16, .render_size = 16});
+  const envs::MimoEnv* reach = inner.get();
+  const int ball = mj_name2id(reach->model(), mjOBJ_BODY, "target");
+  CurriculumEnv env(std::move(inner), controller, spec.env_options);
+  const double xml[3] = {0.3, -0.05, 0.7};
+  for (int episode = 0; episode < 3; ++episode) {
+    env.reset();
+    const teach::Task& task = env.task().real;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_GE(task[i], spec.space->mins()[i]);
+      EXPECT_LE(task[i], spec.space->maxs()[i]);
+      EXPECT_NEAR(reach->data()->xpos[3 * ball + i], xml[i] + task[i], 1e-9);
+    }
+  }
+  // Options outside their range or unknown are one-line errors naming what is expected.
+  auto bare = envs::make_sample_env("MIMoReach-v0", {.vision_resolution = 16, .render_size = 16});
+  EXPECT_THROW(bare->set_reset_options({{"target_dx", 0.5}}), UserError);
+  try {
+    bare->set_reset_options({{"ball_speed", 1}});
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected target_dx, target_dy, target_dz"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(TaskSpaceFile, CatchFileSetsDropHeightSpeedAndRadius) {
+  auto [spec, controller] = shipped("mimo_catch.yml");
+  EXPECT_EQ(spec.space->dim_names(),
+            (std::vector<std::string>{"ball_dz", "ball_speed", "ball_radius"}));
+  auto inner = envs::make_sample_env("MIMoCatch-v0", {.vision_resolution = 16, .render_size = 16});
+  const envs::MimoEnv* c = inner.get();
+  const int ball = mj_name2id(c->model(), mjOBJ_BODY, "target");
+  const int geom = mj_name2id(c->model(), mjOBJ_GEOM, "target");
+  const int dof = c->model()->jnt_dofadr[mj_name2id(c->model(), mjOBJ_JOINT, "target_joint")];
+  CurriculumEnv env(std::move(inner), controller, spec.env_options);
+  for (int episode = 0; episode < 3; ++episode) {
+    env.reset();
+    const teach::Task& task = env.task().real;
+    // The ball hovers at its drop height through the settling, then leaves at the set speed.
+    EXPECT_NEAR(c->data()->xpos[3 * ball + 2], 0.8 + task[0], 1e-9);
+    EXPECT_NEAR(c->data()->qvel[dof + 2], -task[1], 1e-9);
+    EXPECT_NEAR(c->model()->geom_size[3 * geom], task[2], 1e-7);
+    // Released, it falls.
+    const double z0 = c->data()->xpos[3 * ball + 2];
+    env.step(std::vector<double>(c->action_space().size(), 0.0));
+    EXPECT_LT(c->data()->xpos[3 * ball + 2], z0);
+  }
+}
+
+TEST(TaskSpaceFile, CubesFileMovesTheStackAwayFromMimo) {
+  auto [spec, controller] = shipped("babybench_cubes.yml");
+  EXPECT_EQ(spec.space->dim_names(), std::vector<std::string>{"cube_distance"});
+  Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_handregard.yml");
+  config.vision_active = false;  // the cubes are what matters here
+  auto inner = std::make_unique<envs::BabyBenchEnv>(envs::make_assets(config));
+  const envs::BabyBenchEnv* baby = inner.get();
+  const mjModel* m = baby->model();
+  const int root = mj_name2id(m, mjOBJ_BODY, "mimo_location");
+  const int red = mj_name2id(m, mjOBJ_BODY, "red_cube"),
+            blue = mj_name2id(m, mjOBJ_BODY, "blue_cube");
+  CurriculumEnv env(std::move(inner), controller, spec.env_options);
+  auto horizontal = [&](int body) {
+    const double* p = baby->data()->xpos + 3 * body;
+    const double* r = baby->data()->xpos + 3 * root;
+    return std::hypot(p[0] - r[0], p[1] - r[1]);
+  };
+  for (int episode = 0; episode < 3; ++episode) {
+    env.reset();
+    const double want = env.task().real[0];
+    EXPECT_NEAR(horizontal(red), want, 0.005);
+    // The stack moved as one: the blue cube keeps its place beside the red one.
+    const double* r = baby->data()->xpos + 3 * red;
+    const double* b = baby->data()->xpos + 3 * blue;
+    EXPECT_NEAR(std::hypot(b[0] - r[0], b[1] - r[1]), std::hypot(0.01, 0.0), 0.01);
+  }
+  // Another scene has no cubes: a one-line error.
+  envs::BabyBenchEnv crib(envs::make_assets(
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_selftouch.yml")));
+  EXPECT_THROW(crib.set_reset_options({{"cube_distance", 0.3}}), UserError);
 }
 
 }  // namespace

@@ -2,10 +2,13 @@
 // falling ball (random size, mass and drop point) and must catch it and hold it for one second.
 // Muscle actuation by default; head and eyes follow the ball. Reward per step: +1 while touching
 // the ball, -40 x muscle cost, -100 on dropping it (failure), +100 on holding it for 100 steps
-// (success); both end the episode.
+// (success); both end the episode. Reset options (a curriculum's parameters) fix what the reference
+// draws: the drop point's offset ball_dx, ball_dy, ball_dz, ball_radius and ball_mass; ball_speed
+// throws the ball down at that speed when it is released.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "envs/mimo/sample_env.h"
@@ -26,6 +29,9 @@ constexpr double kMinForce = 1e-9;     // N, the touch threshold
 constexpr double kBallPos[3] = {0.24, -0.04, 0.8};
 constexpr double kBallJitter[3] = {0.01, 0.01, 0.08};
 constexpr double kRadius[2] = {0.005, 0.025}, kMass[2] = {0.05, 0.5};
+// What reset options may set: offsets (m), downward speed (m/s), radius (m), mass (kg).
+constexpr double kOptionOffset = 0.3, kOptionSpeed = 5;
+constexpr double kOptionRadius[2] = {0.005, 0.05}, kOptionMass[2] = {0.01, 2};
 // Jitter: gains per action dimension, redrawn every 10 to 50 steps.
 constexpr double kGain[2] = {0.8, 1.2};
 constexpr int kGainSteps[2] = {10, 51};
@@ -83,13 +89,15 @@ class Catch final : public SampleTask {
     mjModel* m = model_;
     mjData* d = core.data();
     // A new ball: drop point, radius and mass (solid sphere inertia).
+    // (Every value is drawn, so the stream stays the same; a set option replaces it.)
     for (int i = 0; i < 3; ++i) {
-      d->qpos[ball_qpos_ + i] = kBallPos[i] + rng.uniform(-kBallJitter[i], kBallJitter[i]);
+      const double drawn = rng.uniform(-kBallJitter[i], kBallJitter[i]);
+      d->qpos[ball_qpos_ + i] = kBallPos[i] + set_[i].value_or(drawn);
     }
     mju_zero(d->qvel + ball_dof_, 6);
     if (options_.palm_up) d->qpos[wrist_qpos_] = kPalmUpAngle;
-    radius_ = rng.uniform(kRadius[0], kRadius[1]);
-    const double mass = rng.uniform(kMass[0], kMass[1]);
+    radius_ = set_[kRadiusSlot].value_or(rng.uniform(kRadius[0], kRadius[1]));
+    const double mass = set_[kMassSlot].value_or(rng.uniform(kMass[0], kMass[1]));
     m->geom_size[3 * ball_geom_] = radius_;
     m->geom_rbound[ball_geom_] = radius_;
     m->body_mass[ball_body_] = mass;
@@ -113,6 +121,7 @@ class Catch final : public SampleTask {
     core.sim().actuation().apply(zero_, d);
     for (int i = 0; i < kSettleSteps; ++i) core.raw_step();
     m->opt.gravity[2] = gravity;
+    d->qvel[ball_dof_ + 2] = -set_[kSpeedSlot].value_or(0);  // released (or thrown) downward
     held_.fill(0);
     after_physics(core);
     mj_forward(m, d);
@@ -128,6 +137,17 @@ class Catch final : public SampleTask {
       jittered_[k] = std::clamp(action[k] * gains_[k], low_[k], high_[k]);
     }
     return jittered_;
+  }
+
+  void set_reset_options(const ResetOptions& options) override {
+    const TaskOption known[] = {
+        {"ball_dx", -kOptionOffset, kOptionOffset, &set_[0]},
+        {"ball_dy", -kOptionOffset, kOptionOffset, &set_[1]},
+        {"ball_dz", -kOptionOffset, kOptionOffset, &set_[2]},
+        {"ball_speed", 0, kOptionSpeed, &set_[kSpeedSlot]},
+        {"ball_radius", kOptionRadius[0], kOptionRadius[1], &set_[kRadiusSlot]},
+        {"ball_mass", kOptionMass[0], kOptionMass[1], &set_[kMassSlot]}};
+    set_task_options("MIMoCatch-v0", known, options);
   }
 
   // Records whether the ball touches the right arm this step, and aims head and eyes at it.
@@ -172,6 +192,9 @@ class Catch final : public SampleTask {
   }
 
  private:
+  // Reset options: offsets 0-2, then speed, radius, mass.
+  static constexpr int kSpeedSlot = 3, kRadiusSlot = 4, kMassSlot = 5;
+  std::array<std::optional<double>, 6> set_;
   SampleOptions options_;
   mjModel* model_;  // the core's own copy
   HeadTracking tracking_;

@@ -1,7 +1,11 @@
 // MIMoReach-v0 (mimo_core.md §6.1): MIMo, welded in place without gravity, reaches with his right
 // arm for a hovering ball; head and eyes follow the ball. Reward: minus the hand-ball distance,
-// +100 when the ball is knocked more than 1 cm out of place (success, ends the episode).
+// +100 when the ball is knocked more than 1 cm out of place (success, ends the episode). Reset
+// options target_dx, target_dy, target_dz fix the ball's offset from its XML position (a
+// curriculum's reach distance) instead of the reference's uniform draw.
+#include <array>
 #include <cmath>
+#include <optional>
 
 #include "envs/mimo/sample_env.h"
 
@@ -12,6 +16,9 @@ constexpr double kTarget[3] = {0.3, -0.05, 0.7};  // the ball's XML position
 constexpr double kKnockedOut = 0.01;              // m the ball must move for success
 constexpr double kTouchReward = 100;
 constexpr int kRandomResetSteps = 10;
+// The reference's offset draw per axis (m), and the range a reset option may set.
+constexpr double kOffset[3][2] = {{-0.1, 0}, {-0.2, 0.1}, {-0.1, 0}};
+constexpr double kOptionRange = 0.3;
 
 class Reach final : public SampleTask {
  public:
@@ -36,10 +43,12 @@ class Reach final : public SampleTask {
       core.raw_step();
       after_physics(core);
     }
+    // Every offset is drawn (the stream stays the same), then a set option replaces it.
     double* ball = d->qpos + target_qpos_;
-    ball[0] = kTarget[0] + rng.uniform(-0.1, 0);
-    ball[1] = kTarget[1] + rng.uniform(-0.2, 0.1);
-    ball[2] = kTarget[2] + rng.uniform(-0.1, 0);
+    for (int i = 0; i < 3; ++i) {
+      const double drawn = rng.uniform(kOffset[i][0], kOffset[i][1]);
+      ball[i] = kTarget[i] + offset_[i].value_or(drawn);
+    }
     mju_zero(d->qvel, m->nv);
     mj_forward(m, d);
     mju_copy3(start_, target_pos(d));
@@ -47,6 +56,13 @@ class Reach final : public SampleTask {
 
   void after_physics(MimoCore& core) override {
     tracking_.aim(core.model(), core.data(), target_pos(core.data()));
+  }
+
+  void set_reset_options(const ResetOptions& options) override {
+    const TaskOption known[] = {{"target_dx", -kOptionRange, kOptionRange, &offset_[0]},
+                                {"target_dy", -kOptionRange, kOptionRange, &offset_[1]},
+                                {"target_dz", -kOptionRange, kOptionRange, &offset_[2]}};
+    set_task_options("MIMoReach-v0", known, options);
   }
 
   double after_step(const MimoCore& core, Info& info) override {
@@ -66,6 +82,7 @@ class Reach final : public SampleTask {
   int target_body_, target_qpos_, fingers_;
   std::vector<double> random_action_;
   double start_[3] = {0, 0, 0};
+  std::array<std::optional<double>, 3> offset_;  // reset options (m)
 };
 
 }  // namespace

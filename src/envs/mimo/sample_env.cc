@@ -212,6 +212,25 @@ MimoEnv::MimoEnv(std::shared_ptr<const SampleAssets> assets, std::uint64_t seed)
   core_.sim().restore(assets_->init);
 }
 
+void set_task_options(std::string_view env, std::span<const TaskOption> known,
+                      const ResetOptions& options) {
+  for (const auto& [name, value] : options) {
+    const auto it =
+        std::ranges::find_if(known, [&](const TaskOption& o) { return name == o.name; });
+    if (it == known.end()) {
+      std::string names;
+      for (const TaskOption& o : known) names += (names.empty() ? "" : ", ") + std::string(o.name);
+      throw UserError("reset option '" + name + "' is not one " + std::string(env) +
+                      " takes (expected " + (names.empty() ? "none" : names) + ")");
+    }
+    if (!(value >= it->lo && value <= it->hi)) {
+      throw UserError("reset option " + name + " of " + std::string(env) + " must be in [" +
+                      num(it->lo) + ", " + num(it->hi) + "], not " + num(value));
+    }
+    *it->value = value;
+  }
+}
+
 MimoEnv::~MimoEnv() = default;
 
 const ObservationLayout* MimoEnv::layout(std::string_view key) const {

@@ -102,6 +102,18 @@ std::unique_ptr<MimoEnv> make_sample_env(std::shared_ptr<const SampleAssets> ass
 std::unique_ptr<MimoEnv> make_sample_env(std::string_view name, const SampleOptions& options = {},
                                          std::uint64_t seed = 0);
 
+// One reset option of a sample task: its name, accepted range and where the task keeps it (unset:
+// the task draws the value as the reference does).
+struct TaskOption {
+  const char* name;
+  double lo, hi;
+  std::optional<double>* value;
+};
+// Keeps each option's value; UserError naming the env for an unknown name (listing the known
+// ones) or a value outside its range.
+void set_task_options(std::string_view env, std::span<const TaskOption> known,
+                      const ResetOptions& options);
+
 // A sample task: declares the reference's "is_success" and "is_failure" and sets them every step
 // (set_outcome, from after_step); its info holds nothing else.
 class SampleTask : public Task {
@@ -139,6 +151,11 @@ class MimoEnv final : public Env {
   const ObservationBuffers& observation() const override { return core_.observation(); }
   const Info& info() const override { return info_; }
   const ObservationLayout* layout(std::string_view key) const override;
+  // The task's options (reach: target_dx/dy/dz; catch: ball_dx/dy/dz, ball_speed, ball_radius,
+  // ball_mass), kept for every later reset.
+  void set_reset_options(const ResetOptions& options) override {
+    task_->set_reset_options(options);
+  }
 
   const SampleAssets& assets() const { return *assets_; }
   const SampleDefinition& definition() const { return assets_->definition; }
