@@ -6,35 +6,16 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/spin.h"
 
 namespace cradle {
 namespace {
 
-// How long a participant polls before sleeping. A loop that follows soon after the last one
-// (an env step after the learner's forward pass) then starts, and a caller whose share ended
-// first sees the others finish, without a futex round trip, which on a VM costs as much as the
-// typical imbalance between two env steps. 2,000 pauses (about 40 us) lost 10 % of 2-env
-// throughput against 250 us (BM_VecEnvScalingSelfTouch).
+// How long a participant polls before sleeping (spin_until). A loop that follows soon after the
+// last one (an env step after the learner's forward pass) then starts, and a caller whose share
+// ended first sees the others finish, without a futex round trip. 2,000 pauses (about 40 us) lost
+// 10 % of 2-env throughput against 250 us (BM_VecEnvScalingSelfTouch).
 constexpr std::chrono::microseconds kSpinTime{250};
-
-void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
-
-// Polls `ready` for up to kSpinTime; true when it became true.
-template <class Ready>
-bool spin_until(Ready ready) {
-  const auto deadline = std::chrono::steady_clock::now() + kSpinTime;
-  for (int k = 1;; ++k) {
-    if (ready()) return true;
-    pause();
-    if (k % 64 == 0 && std::chrono::steady_clock::now() > deadline) return ready();
-  }
-}
 
 }  // namespace
 
@@ -86,7 +67,7 @@ void ThreadPool::run(int n, Task task) {
   work(0);
 
   // Wait for the workers: poll, then sleep.
-  if (!spin_until([this] { return pending_.load(std::memory_order_acquire) == 0; })) {
+  if (!spin_until([this] { return pending_.load(std::memory_order_acquire) == 0; }, kSpinTime)) {
     std::unique_lock lock(mutex_);
     done_cv_.wait(lock, [this] { return pending_.load(std::memory_order_acquire) == 0; });
   }
@@ -116,10 +97,12 @@ void ThreadPool::worker_loop(int participant) {
   for (;;) {
     // Wait for the next loop: poll, then sleep.
     std::uint32_t generation = seen;
-    if (!spin_until([&] {
-          generation = generation_.load(std::memory_order_acquire);
-          return generation != seen;
-        })) {
+    if (!spin_until(
+            [&] {
+              generation = generation_.load(std::memory_order_acquire);
+              return generation != seen;
+            },
+            kSpinTime)) {
       std::unique_lock lock(mutex_);
       start_cv_.wait(lock, [&] {
         generation = generation_.load(std::memory_order_acquire);

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "core/spin.h"
 #include "envs/action_check.h"
 
 namespace cradle::learn {
@@ -40,25 +41,6 @@ void check_envs(const std::vector<std::unique_ptr<envs::Env>>& envs) {
 // round trip. The caller never polls in recv(): the other envs keep the workers busy while it
 // sleeps, and on 2 cores its polling would take a worker's core.
 constexpr std::chrono::microseconds kAsyncSpin{50};
-
-void pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
-
-// Polls `ready` for up to kAsyncSpin; true when it became true.
-template <class Ready>
-bool poll(Ready ready) {
-  const auto deadline = std::chrono::steady_clock::now() + kAsyncSpin;
-  for (int k = 1;; ++k) {
-    if (ready()) return true;
-    pause();
-    if (k % 64 == 0 && std::chrono::steady_clock::now() > deadline) return ready();
-  }
-}
 
 }  // namespace
 
@@ -245,7 +227,7 @@ void AsyncVecEnv::worker_loop() {
   const int n = num_envs();
   for (;;) {
     // Take the oldest queued job, polling briefly before sleeping.
-    poll([this] { return queued_.load(std::memory_order_acquire) > 0; });
+    spin_until([this] { return queued_.load(std::memory_order_acquire) > 0; }, kAsyncSpin);
     int e = 0;
     {
       std::unique_lock lock(mutex_);

@@ -16,6 +16,7 @@
 #include "learn/run_files.h"
 #include "learn/vector_env.h"
 #include "train/curriculum_env.h"
+#include "train/loop.h"
 
 namespace cradle::train {
 namespace {
@@ -31,21 +32,6 @@ const char* const kTestHeader = "evaluation,env_steps,task_index,return,mastered
 const char* const kLogs[] = {"progress.csv", "test_returns.csv", "teacher.jsonl"};
 // Arguments a resumed run may change.
 const char* const kResumable[] = {"nb_env_steps", "test_every", "resume", "out", "progress_bar"};
-
-std::string cell(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-std::string duration_text(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
-  const long s = static_cast<long>(seconds);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-  return buf;
-}
 
 // Writes `text` to `file` through a temp file and a rename (never half a file).
 void write_atomically(const fs::path& file, const std::string& text) {
@@ -324,7 +310,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     csv << "\n";
     for (std::size_t i = 0; i < test_set.size(); ++i) {
       csv << i;
-      for (float v : test_set[i]) csv << "," << cell(v);
+      for (float v : test_set[i]) csv << "," << csv_cell(v);
       csv << "\n";
     }
     write_atomically(dir / "test_set.csv", csv.str());
@@ -416,7 +402,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
       controller->record_test_episode(ret, length);
       returns.push_back(ret);
       const bool mastered = ret > env.success_threshold;
-      test_csv << evaluation << "," << steps << "," << i << "," << cell(ret) << ","
+      test_csv << evaluation << "," << steps << "," << i << "," << csv_cell(ret) << ","
                << (mastered ? 1 : 0) << "\n";
     }
     double mean = 0, var = 0;
@@ -429,11 +415,11 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     const double pct = 100.0 * mastered / returns.size();
     result.eval_s += std::chrono::duration<double>(Clock::now() - eval_start).count();
     const double wall = wall_before + elapsed();
-    progress << evaluation << "," << steps << "," << controller->episodes() << "," << cell(wall)
-             << "," << cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << "," << cell(mean)
-             << "," << cell(std::sqrt(var)) << "," << cell(pct) << ","
-             << cell(train_returns ? train_return_sum / train_returns : std::nan("")) << ","
-             << cell(updates_done) << "," << cell(train_env->teacher_seconds()) << "\n";
+    progress << evaluation << "," << steps << "," << controller->episodes() << "," << csv_cell(wall)
+             << "," << csv_cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << ","
+             << csv_cell(mean) << "," << csv_cell(std::sqrt(var)) << "," << csv_cell(pct) << ","
+             << csv_cell(train_returns ? train_return_sum / train_returns : std::nan("")) << ","
+             << csv_cell(updates_done) << "," << csv_cell(train_env->teacher_seconds()) << "\n";
     train_return_sum = 0;
     train_returns = 0;
     teacher_log.write(
@@ -487,7 +473,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
                      std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
                      steps, o.total_steps, rate,
                      duration_text((o.total_steps - steps) / std::max(rate, 1e-9)).c_str(),
-                     cell(result.last_pct_mastered).c_str());
+                     csv_cell(result.last_pct_mastered).c_str());
         std::fflush(stderr);
       }
       return !stopped();
