@@ -108,26 +108,33 @@ def train(
     return result
 
 
-def load_policy(config, checkpoint):
-    """A trained checkpoint's deterministic policy, for evaluate(policy=...)."""
-    return _cradle.load_policy(load_config(config), os.fspath(checkpoint))
+def load_policy(config, checkpoint, stochastic=False):
+    """A trained checkpoint's policy, for evaluate(policy=...): its mean action, or with
+    stochastic=True actions sampled from its distribution by the checkpoint's own generator."""
+    return _cradle.load_policy(load_config(config), os.fspath(checkpoint), bool(stochastic))
 
 
 def evaluate(config, episodes=10, duration=1000, render=True, seed=0, policy=None,
-             video_format="mp4", quiet=False):
+             video_format="mp4", quiet=False, stochastic=False):
     """Runs the evaluation as `cradle evaluate`: prints the training-log score, runs `episodes`
     episodes of `duration` steps, writes trajectories/, videos/, evaluation.json and plots/ under
     save_dir, and returns the report as a dict.
 
     policy: None (uniform random actions), a checkpoint path, a load_policy() result, or a
     callable fn(obs) -> action (fresh observation arrays; called with the GIL for each step).
+    stochastic: with a checkpoint path, sample the policy's actions (SB3's predict() default)
+    instead of taking its mean action; evaluation.json's policy_actions says which was used.
     """
+    if stochastic and not isinstance(policy, (str, os.PathLike)):
+        raise ValueError("stochastic=True needs policy to be a checkpoint path "
+                         "(use load_policy(config, path, stochastic=True) otherwise)")
     if video_format not in ("mp4", "avi"):
         raise ValueError("video_format must be 'mp4' or 'avi'")
     if isinstance(policy, os.PathLike):
         policy = os.fspath(policy)
     report = _cradle.evaluate(load_config(config), int(episodes), int(duration), bool(render),
-                              int(seed), "." + video_format, bool(quiet), policy)
+                              int(seed), "." + video_format, bool(quiet), policy,
+                              bool(stochastic))
     return json.loads(report)
 
 

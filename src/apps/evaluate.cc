@@ -22,6 +22,7 @@ void register_evaluate(CLI::App& app) {
     std::uint64_t seed = 0;
     std::string format = "mp4";
     std::string policy;
+    bool stochastic = false;
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -40,8 +41,12 @@ void register_evaluate(CLI::App& app) {
       ->check(CLI::Range(1, 100000000));
   cmd->add_flag("--render,!--no-render", opts->render, "Write a video per episode (default on)");
   cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i")->check(kSeed);
-  cmd->add_option("--policy", opts->policy,
-                  "Checkpoint of a trained policy (cradle train); default: random actions");
+  CLI::Option* policy_option =
+      cmd->add_option("--policy", opts->policy,
+                      "Checkpoint of a trained policy (cradle train); default: random actions");
+  cmd->add_flag("--stochastic", opts->stochastic,
+                "Sample the policy's actions (SB3's predict() default) instead of its mean action")
+      ->needs(policy_option);
   cmd->add_option("--video-format", opts->format, "Video container")
       ->check(CLI::IsMember({"mp4", "avi"}));
   cmd->callback([opts] {
@@ -51,10 +56,11 @@ void register_evaluate(CLI::App& app) {
                                      .duration = opts->duration,
                                      .render = opts->render,
                                      .seed = opts->seed,
-                                     .video_extension = "." + opts->format};
+                                     .video_extension = "." + opts->format,
+                                     .policy_actions = opts->stochastic ? "sampled" : "mean"};
     const std::string behavior(behavior_name(config.behavior));
     const train::Policy policy =
-        opts->policy.empty() ? nullptr : train::load_policy(config, opts->policy);
+        opts->policy.empty() ? nullptr : train::load_policy(config, opts->policy, opts->stochastic);
     const train::EvaluationReport r = train::evaluate(config, options, policy);
     if (r.training_score) {
       std::printf("training log: %d entries, score %.4f\n", r.training_episodes, *r.training_score);
@@ -63,8 +69,9 @@ void register_evaluate(CLI::App& app) {
                   r.training_episodes ? "no score for behavior none" : "none found");
     }
     if (config.behavior != Behavior::kNone) {
-      std::printf("evaluation (%s, %d episodes x %d steps): %.4f +- %.4f\n", behavior.c_str(),
-                  opts->episodes, opts->duration, r.mean, r.std);
+      std::printf("evaluation (%s, %d episodes x %d steps, %s actions): %.4f +- %.4f\n",
+                  behavior.c_str(), opts->episodes, opts->duration,
+                  opts->policy.empty() ? "random" : options.policy_actions.c_str(), r.mean, r.std);
     }
     if (config.behavior == Behavior::kHandRegard) {
       double either = 0;

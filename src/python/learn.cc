@@ -327,6 +327,7 @@ train::Policy python_policy(py::object callable) {
 // A trained checkpoint's deterministic policy (cradle.load_policy).
 struct PyPolicy {
   train::Policy policy;
+  bool sampled = false;  // actions drawn from the policy's distribution instead of its mean
   int action_dim = 0;
 };
 
@@ -405,15 +406,18 @@ void bind_learn(py::module_& m) {
       .def_readonly("action_dim", &PyPolicy::action_dim);
   m.def(
       "load_policy",
-      [](const Config& config, const std::string& checkpoint) {
-        return PyPolicy{without_gil([&] { return train::load_policy(config, checkpoint); })};
+      [](const Config& config, const std::string& checkpoint, bool stochastic) {
+        return PyPolicy{.policy = without_gil(
+                            [&] { return train::load_policy(config, checkpoint, stochastic); }),
+                        .sampled = stochastic};
       },
-      py::arg("config"), py::arg("checkpoint"));
+      py::arg("config"), py::arg("checkpoint"), py::arg("stochastic"));
 
   m.def(
       "evaluate",
       [](const Config& config, int episodes, int duration, bool render, std::uint64_t seed,
-         const std::string& video_extension, bool quiet, const py::object& policy) {
+         const std::string& video_extension, bool quiet, const py::object& policy,
+         bool stochastic) {
         train::EvaluationOptions o{.episodes = episodes,
                                    .duration = duration,
                                    .render = render,
@@ -422,18 +426,22 @@ void bind_learn(py::module_& m) {
                                    .quiet = quiet};
         train::Policy p;
         if (py::isinstance<PyPolicy>(policy)) {
-          p = policy.cast<const PyPolicy&>().policy;
+          const PyPolicy& loaded = policy.cast<const PyPolicy&>();
+          p = loaded.policy;
+          o.policy_actions = loaded.sampled ? "sampled" : "mean";
         } else if (py::isinstance<py::str>(policy)) {
           const std::string checkpoint = policy.cast<std::string>();  // with the GIL
-          p = without_gil([&] { return train::load_policy(config, checkpoint); });
+          p = without_gil([&] { return train::load_policy(config, checkpoint, stochastic); });
+          o.policy_actions = stochastic ? "sampled" : "mean";
         } else if (!policy.is_none()) {
           p = python_policy(policy);
+          o.policy_actions = "custom";
         }
         return without_gil([&] { return train::evaluate(config, o, p); }).to_json().dump();
       },
       py::arg("config"), py::arg("episodes"), py::arg("duration"), py::arg("render"),
       py::arg("seed"), py::arg("video_extension"), py::arg("quiet"), py::arg("policy"),
-      "Runs the evaluation episodes; returns the report as JSON text.");
+      py::arg("stochastic"), "Runs the evaluation episodes; returns the report as JSON text.");
 
   m.def(
       "training_score",

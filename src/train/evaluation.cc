@@ -269,6 +269,7 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   out["seed"] = options.seed;
   out["episodes_requested"] = options.episodes;
   out["duration"] = options.duration;
+  out["policy_actions"] = given_policy ? options.policy_actions : "random";
   out["versions"] = {{"cradle", CRADLE_VERSION}, {"mujoco", mj_versionString()}};
   std::ofstream file(dir / "evaluation.json");
   file << out.dump(2) << "\n";

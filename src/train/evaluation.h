@@ -28,6 +28,10 @@ struct EvaluationOptions {
   std::string video_extension = ".mp4";  // or ".avi"
   double video_fps = 0;                  // 0: real time (1 / env step duration)
   bool quiet = false;                    // no per-episode lines on stdout
+  // How the policy acts, recorded in evaluation.json: "random" (no policy), "mean" (a checkpoint's
+  // deterministic action), "sampled" (drawn from its distribution) or "custom" (a caller's
+  // function).
+  std::string policy_actions = "random";
 };
 
 struct EpisodeResult {

@@ -402,7 +402,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                 .duration = options.eval_duration,
                                 .render = options.eval_render,
                                 .seed = options.seed + 1000,
-                                .quiet = true};
+                                .quiet = true,
+                                .policy_actions = "mean"};
     Learner* l = learner.get();
     result.evaluation =
         train::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
@@ -418,7 +419,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   return result;
 }
 
-train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint) {
+train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,
+                          bool sampled) {
   if (!fs::exists(checkpoint)) {
     throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
   }
@@ -428,8 +430,8 @@ train::Policy load_policy(const Config& config, const std::filesystem::path& che
   LearnerOptions lo{.hyperparameters = learn::parse_hyperparameter_text(info.config)};
   std::shared_ptr<Learner> learner = learn::make_learner(info.algorithm, *vec, lo);
   learner->load(checkpoint);
-  return [vec, learner](const envs::BabyBenchEnv& env, std::span<double> action) {
-    learner->act(env.observation(), action, /*deterministic=*/true);
+  return [vec, learner, sampled](const envs::BabyBenchEnv& env, std::span<double> action) {
+    learner->act(env.observation(), action, /*deterministic=*/!sampled);
   };
 }
 

@@ -70,7 +70,10 @@ struct TrainResult {
 
 TrainResult train(const Config& config, const TrainOptions& options);
 
-// The policy of a checkpoint, for `cradle evaluate --policy` (deterministic actions).
-train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint);
+// The policy of a checkpoint, for `cradle evaluate --policy`: the mean action, or with `sampled`
+// actions drawn from the policy's distribution (as SB3's predict() does by default) by the
+// checkpoint's own generator, so a sampled evaluation of one checkpoint repeats exactly.
+train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,
+                          bool sampled = false);
 
 }  // namespace cradle::train

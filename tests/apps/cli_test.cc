@@ -46,8 +46,8 @@ std::string write_training_config(const fs::path& dir) {
 
 TEST(Cli, BuildSceneWritesSceneAndTextures) {
   const fs::path dir = temp_dir("build");
-  const CliResult r =
-      run_cradle("build-scene --config " + config("config_selftouch.yml") + " --out " + dir.string());
+  const CliResult r = run_cradle("build-scene --config " + config("config_selftouch.yml") +
+                                 " --out " + dir.string());
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_TRUE(fs::exists(dir / "scene.xml"));
   EXPECT_TRUE(fs::exists(dir / "tex_head_default_right.png"));
@@ -94,7 +94,8 @@ TEST(Cli, BadConfigGivesOneLineError) {
 }
 
 TEST(Cli, BenchJsonReportsRatesAndModules) {
-  const CliResult r = run_cradle("bench --json --steps 200 --config " + config("config_selftouch.yml"));
+  const CliResult r =
+      run_cradle("bench --json --steps 200 --config " + config("config_selftouch.yml"));
   ASSERT_EQ(r.status, 0) << r.out;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_GT(j["env_steps_per_s"].get<double>(), 0);
@@ -174,6 +175,11 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
   EXPECT_EQ(report["episodes"].size(), 2u);
   EXPECT_EQ(report["training_log"]["episodes"], 4);  // 0-step entry, 2 full, 1 partial
   EXPECT_TRUE(report["score"].contains("mean"));
+  EXPECT_EQ(report["policy_actions"], "random");
+  // Sampling needs a policy to sample from: one line, exit 1 (CLI11's "requires").
+  const CliResult sampled = run_cradle("evaluate --config ../config.yml --stochastic", elsewhere);
+  EXPECT_NE(sampled.status, 0);
+  EXPECT_NE(sampled.out.find("--stochastic requires --policy"), std::string::npos) << sampled.out;
   fs::remove_all(dir);
 }
 

@@ -45,6 +45,20 @@ def test_train_with_python_intrinsic_reward(make_config):
     report = cradle.evaluate(config, episodes=1, duration=20, render=False,
                              policy=result["checkpoint"], quiet=True)
     assert len(report["episodes"]) == 1
+    mean_qpos = np.load(f"{save_dir}/trajectories/episode_0.npz")["qpos"]
+    assert json.load(open(f"{save_dir}/evaluation.json"))["policy_actions"] == "mean"
+    # Sampled actions: drawn by the checkpoint's generator, so they repeat, and differ from the
+    # mean action's trajectory.
+    sampled = []
+    for _ in range(2):
+        cradle.evaluate(config, episodes=1, duration=20, render=False,
+                        policy=result["checkpoint"], quiet=True, stochastic=True)
+        sampled.append(np.load(f"{save_dir}/trajectories/episode_0.npz")["qpos"])
+        assert json.load(open(f"{save_dir}/evaluation.json"))["policy_actions"] == "sampled"
+    assert np.array_equal(sampled[0], sampled[1])
+    assert not np.allclose(sampled[0], mean_qpos)
+    with pytest.raises(ValueError, match="stochastic=True needs policy to be a checkpoint path"):
+        cradle.evaluate(config, episodes=1, duration=5, render=False, quiet=True, stochastic=True)
 
 
 def test_python_reward_errors_propagate(make_config):
