@@ -81,6 +81,74 @@ void cut_back(const fs::path& file, std::uintmax_t size) {
             << "\n";
 }
 
+// Splits a CSV line of plain cells (our logs hold numbers and names, never quotes).
+std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::size_t at = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', at);
+    cells.push_back(line.substr(at, comma == std::string::npos ? comma : comma - at));
+    if (comma == std::string::npos) return cells;
+    at = comma + 1;
+  }
+}
+
+// A log written by a binary with other columns (an older one: fewer) under the current `header`.
+// When every old column is among the current ones, the file is rewritten in place: each row's
+// cells move under their column's name and the columns the old binary lacked stay empty, so one
+// CSV holds the whole run and nothing is lost. Otherwise (a column would be dropped, or a row
+// does not fit its header) the file is kept whole as <stem>.before-resume[-k]<ext> and a fresh
+// one begins. Returns whether the file still needs its header (kept aside or missing); prints one
+// line when it changed anything.
+bool adopt_header(const fs::path& file, const std::string& header) {
+  std::ifstream in(file);
+  std::string first;
+  if (!in || !std::getline(in, first)) return true;
+  if (first == header) return false;
+  const std::vector<std::string> now = split_cells(header), old = split_cells(first);
+  std::vector<int> where(old.size(), -1);  // each old column's index in the current header
+  bool fits = true;
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto it = std::find(now.begin(), now.end(), old[c]);
+    if (it == now.end())
+      fits = false;
+    else
+      where[c] = static_cast<int>(it - now.begin());
+  }
+  std::ostringstream text;
+  text << header << "\n";
+  for (std::string line; fits && std::getline(in, line);) {
+    const std::vector<std::string> cells = split_cells(line);
+    if (cells.size() != old.size()) {
+      fits = false;
+      break;
+    }
+    std::vector<std::string> row(now.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) row[where[c]] = cells[c];
+    for (std::size_t c = 0; c < row.size(); ++c) text << (c ? "," : "") << row[c];
+    text << "\n";
+  }
+  in.close();
+  if (fits) {
+    write_atomically(file, text.str());
+    std::cerr << file.filename().string() << ": rows of an older header rewritten under the "
+              << "current one (new columns empty)\n";
+    return false;
+  }
+  fs::path kept;
+  for (int k = 1; k == 1 || fs::exists(kept); ++k) {
+    kept =
+        file.parent_path() / (file.stem().string() + ".before-resume" +
+                              (k > 1 ? "-" + std::to_string(k) : "") + file.extension().string());
+  }
+  std::error_code ec;
+  fs::rename(file, kept, ec);
+  if (ec) throw UserError("cannot rename '" + file.string() + "': " + ec.message());
+  std::cerr << file.filename().string() << ": written with other columns, kept as " << kept.string()
+            << "\n";
+  return true;
+}
+
 // VecNormalize's return normalisation (Baselines' ppo2 as TeachMyAgent runs it): each env keeps
 // its discounted return ret = gamma ret + r (zeroed when an episode ends), a running variance of
 // ret over every step, and the learner trains on r / sqrt(var + 1e-8) clipped to +-10. Autoreset
@@ -337,15 +405,29 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   }
   auto run_steps = [&] { return offset + learner->steps(); };
 
-  // The logs: appended to on resume (already cut back), fresh otherwise.
-  std::ofstream progress(dir / "progress.csv", o.resume ? std::ios::app : std::ios::trunc);
-  std::ofstream test_csv(dir / "test_returns.csv", o.resume ? std::ios::app : std::ios::trunc);
+  // The logs: appended to on resume (already cut back; an older binary's columns adopted, and
+  // the checkpoint's sizes then follow the rewritten files), fresh otherwise.
+  bool progress_header = true, test_header = true;
+  if (o.resume) {
+    progress_header = adopt_header(dir / "progress.csv", kProgressHeader);
+    test_header = adopt_header(dir / "test_returns.csv", kTestHeader);
+    nlohmann::json sizes = state["sizes"];
+    for (const char* name : {"progress.csv", "test_returns.csv"}) {
+      std::error_code ec;
+      const std::uintmax_t size = fs::exists(dir / name, ec) ? fs::file_size(dir / name, ec) : 0;
+      sizes[name] = size;
+    }
+    if (sizes != state["sizes"]) {
+      state["sizes"] = sizes;
+      write_atomically(state_file, state.dump(2) + "\n");
+    }
+  }
+  std::ofstream progress(dir / "progress.csv", progress_header ? std::ios::trunc : std::ios::app);
+  std::ofstream test_csv(dir / "test_returns.csv", test_header ? std::ios::trunc : std::ios::app);
   if (!progress || !test_csv)
     throw UserError("cannot write the run's logs in '" + dir.string() + "'");
-  if (!o.resume) {
-    progress << kProgressHeader << "\n";
-    test_csv << kTestHeader << "\n";
-  }
+  if (progress_header) progress << kProgressHeader << "\n";
+  if (test_header) test_csv << kTestHeader << "\n";
   JsonlWriter teacher_log(dir / "teacher.jsonl", o.resume);
 
   int evaluation = o.resume ? state["evaluation"].get<int>() + 1 : 0;
