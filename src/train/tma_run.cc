@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <span>
 #include <sstream>
 
 #include "core/error.h"
@@ -149,45 +148,6 @@ bool adopt_header(const fs::path& file, const std::string& header) {
   return true;
 }
 
-// VecNormalize's return normalisation (Baselines' ppo2 as TeachMyAgent runs it): each env keeps
-// its discounted return ret = gamma ret + r (zeroed when an episode ends), a running variance of
-// ret over every step, and the learner trains on r / sqrt(var + 1e-8) clipped to +-10. Autoreset
-// steps (no transition) neither add to ret nor to the statistics. Its statistics start afresh in
-// every process (a resumed run does not restore them).
-class ReturnNormalizer {
- public:
-  explicit ReturnNormalizer(double gamma) : gamma_(gamma) {}
-  void operator()(const learn::VecEnv& env, std::span<const double>, std::span<double> rewards) {
-    const int n = env.num_envs();
-    if (ret_.empty()) {
-      ret_.assign(n, 0.0);
-      ended_.assign(n, 0);
-    }
-    for (int i = 0; i < n; ++i) {
-      if (ended_[i]) {  // this step only reset the env
-        ended_[i] = 0;
-        continue;
-      }
-      ret_[i] = gamma_ * ret_[i] + rewards[i];
-      // Running mean and variance (Chan et al.'s merge of one sample), count starting at 1e-4.
-      const double delta = ret_[i] - mean_, total = count_ + 1;
-      mean_ += delta / total;
-      var_ = (var_ * count_ + delta * delta * count_ / total) / total;
-      count_ = total;
-      rewards[i] = std::clamp(rewards[i] / std::sqrt(var_ + 1e-8), -10.0, 10.0);
-      if (env.terminated()[i] || env.truncated()[i]) {
-        ret_[i] = 0;
-        ended_[i] = 1;
-      }
-    }
-  }
-
- private:
-  double gamma_, mean_ = 0, var_ = 1, count_ = 1e-4;
-  std::vector<double> ret_;
-  std::vector<std::uint8_t> ended_;
-};
-
 // The teacher's build: the registry's setup from the run's options and the env's facts.
 std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const StudentRunOptions& o,
                                                  const teach::DimensionShuffle* shuffle) {
@@ -209,8 +169,6 @@ std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const St
 }
 
 }  // namespace
-
-learn::RewardHook return_normalizer(double gamma) { return ReturnNormalizer(gamma); }
 
 std::map<std::string, std::string> student_preset(const std::string& student, long total_steps) {
   // SpinningUp SAC as TeachMyAgent runs it (spec §4.1).
@@ -315,27 +273,9 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   // The student; a reset gives a fresh one (criterion 3) with its own seed.
   long offset = 0;
   int student_resets = 0;
-  // normalize_returns is the run's (a reward hook), not the learner's.
-  std::map<std::string, std::string> learner_hp = hyperparameters;
-  bool normalize_returns = false;
-  if (const auto it = learner_hp.find("normalize_returns"); it != learner_hp.end()) {
-    if (it->second != "true" && it->second != "false")
-      throw UserError("--hp normalize_returns=" + it->second + " (expected true or false)");
-    normalize_returns = it->second == "true";
-    learner_hp.erase(it);
-  }
-  double gamma = 0.99;
-  if (learner_hp.contains("gamma")) {
-    try {
-      gamma = std::stod(learner_hp.at("gamma"));
-    } catch (const std::exception&) {
-      // The learner names the bad value.
-    }
-  }
   auto make_student = [&] {
     learn::LearnerOptions lo{.seed = o.seed + 7919 * static_cast<std::uint64_t>(student_resets),
-                             .hyperparameters = learner_hp};
-    if (normalize_returns) lo.reward_hook = return_normalizer(gamma);
+                             .hyperparameters = hyperparameters};
     return learn::make_learner(o.student, vec, lo);
   };
   std::unique_ptr<learn::Learner> learner = make_student();

@@ -229,6 +229,14 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   EXPECT_EQ(state["step_offset"], 500);
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
   EXPECT_EQ(summary["env_steps"], 1000);
+  // The preset's return statistics are in the checkpoint: the run resumes with them.
+  const RunResult resumed = run_cradle(
+      "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.0015 "
+      "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
+      "--hp batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --resume --out " +
+      dir.string());
+  ASSERT_EQ(resumed.status, 0) << resumed.out;
+  EXPECT_EQ(lines(dir / "progress.csv").size(), 5u);
 }
 
 TEST(TmaRun, BadInputIsAOneLineError) {
