@@ -1,5 +1,6 @@
 // `cradle train --config FILE --algo ppo --intrinsic NAME[,NAME...] --steps N --envs K --seed S
-// [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it.
+// [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it. `--env NAME`
+// instead of --config trains a MIMo sample env (e.g. with --task-space and --teacher).
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -36,7 +37,9 @@ void register_train(CLI::App& app) {
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("train", "Train a policy with intrinsic motivation");
-  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  cmd->add_option("--config", opts->config, "BabyBench YAML config (or --env)");
+  cmd->add_option("--env", opts->train.env,
+                  "A MIMo sample env instead: reach, standup, selfbody or catch");
   cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--algo", opts->train.algorithm, "Learning algorithm")
       ->check(CLI::IsMember({"ppo", "a2c", "sac", "td3", "ddpg"}));
@@ -91,7 +94,24 @@ void register_train(CLI::App& app) {
     if (opts->train.resume && cmd->get_option("--algo")->count() == 0) {
       opts->train.algorithm.clear();
     }
-    Config config = load_config(opts->config);
+    // A BabyBench config or a MIMo sample env (its run folder: --save-dir, else results/<env>).
+    Config config;
+    if (opts->train.env.empty()) {
+      if (opts->config.empty()) throw UserError("give --config FILE.yml (BabyBench) or --env NAME");
+      config = load_config(opts->config);
+    } else {
+      if (!opts->config.empty())
+        throw UserError("--config and --env " + opts->train.env + ": give one of them");
+      for (const char* flag : {"--intrinsic", "--randomize-start", "--compare-random",
+                               "--eval-episodes", "--no-eval-video", "--distributed"}) {
+        if (cmd->get_option(flag)->count() > 0)
+          throw UserError(std::string(flag) + " is for BabyBench configs, not --env " +
+                          opts->train.env);
+      }
+      opts->train.intrinsic.clear();  // the sample task's own reward
+      opts->train.eval_episodes = 0;
+      config.save_dir = "results/" + opts->train.env;
+    }
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     for (const std::string& kv : opts->hp) {
       const size_t eq = kv.find('=');
@@ -136,6 +156,11 @@ void register_train(CLI::App& app) {
           "random = %.2f)\n",
           r.random_evaluation->episodes.size(), r.random_evaluation->mean, r.random_evaluation->std,
           r.evaluation ? r.evaluation->mean / r.random_evaluation->mean : 0.0);
+    }
+    if (!opts->train.env.empty()) {
+      std::printf("logs: %s/logs/progress.csv%s; plots: %s/plots/\n", config.save_dir.c_str(),
+                  opts->train.task_space.empty() ? "" : ", teacher.jsonl", config.save_dir.c_str());
+      return;
     }
     std::printf(
         "logs: %s/logs/{training.jsonl, progress.csv}; plots: %s/plots/; videos: %s/videos/\n",

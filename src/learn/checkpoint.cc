@@ -263,8 +263,7 @@ void read_optimizer(torch::serialize::InputArchive& archive, const std::string& 
   }
   if (kind.toStringRef() == "adam" && dynamic_cast<torch::optim::Adam*>(&optimizer)) {
     read_states<torch::optim::AdamParamState, torch::optim::AdamOptions>(nested, optimizer);
-  } else if (kind.toStringRef() == "rmsprop" &&
-             dynamic_cast<torch::optim::RMSprop*>(&optimizer)) {
+  } else if (kind.toStringRef() == "rmsprop" && dynamic_cast<torch::optim::RMSprop*>(&optimizer)) {
     read_states<torch::optim::RMSpropParamState, torch::optim::RMSpropOptions>(nested, optimizer);
   } else {
     throw UserError(key + ": a " + kind.toStringRef() + " optimiser state, not this learner's");
@@ -300,22 +299,26 @@ void read_normalizer(torch::serialize::InputArchive& archive, const std::string&
 void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
                             const torch::nn::Module& policy,
                             const torch::optim::Optimizer& optimizer,
-                            const ObservationPipeline& pipeline, const at::Generator& generator) {
+                            const ObservationPipeline& pipeline, const at::Generator& generator,
+                            const ArchiveWriter& extra) {
   write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) {
     write_module(archive, "policy", policy);
     write_optimizer(archive, "optimizer", optimizer);
     write_normalizer(archive, "normalizer", pipeline);
     write_generator(archive, "generator", generator);
+    if (extra) extra(archive);
   });
 }
 
 CheckpointInfo load_policy_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
                                       const ObservationConfig& observation,
                                       torch::nn::Module& policy, torch::optim::Optimizer& optimizer,
-                                      ObservationPipeline& pipeline, at::Generator& generator) {
+                                      ObservationPipeline& pipeline, at::Generator& generator,
+                                      const ArchiveReader& check) {
   return read_checkpoint(
       file, algorithm, [&](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
         observation.check_matches(header.config);
+        if (check) check(header, archive);
         read_module(archive, "policy", policy);
         read_optimizer(archive, "optimizer", optimizer);
         read_normalizer(archive, "normalizer", pipeline);

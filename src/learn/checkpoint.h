@@ -63,16 +63,19 @@ void read_normalizer(torch::serialize::InputArchive& archive, const std::string&
                      ObservationPipeline& pipeline);
 
 // The whole checkpoint of a policy-gradient learner (PPO, A2C): its policy, optimiser,
-// observation normaliser and generator under fixed keys.
+// observation normaliser and generator under fixed keys, then whatever `extra` adds.
 void save_policy_checkpoint(const std::filesystem::path& file, const CheckpointInfo& header,
                             const torch::nn::Module& policy,
                             const torch::optim::Optimizer& optimizer,
-                            const ObservationPipeline& pipeline, const at::Generator& generator);
-// Reads one back after checking its observation settings against `observation`; returns the
-// header (its step counter is the learner's).
+                            const ObservationPipeline& pipeline, const at::Generator& generator,
+                            const ArchiveWriter& extra = {});
+// Reads one back after checking its observation settings against `observation` and running
+// `check` (it reads and checks what `extra` wrote, before anything changes); returns the header
+// (its step counter is the learner's).
 CheckpointInfo load_policy_checkpoint(const std::filesystem::path& file, std::string_view algorithm,
                                       const ObservationConfig& observation,
                                       torch::nn::Module& policy, torch::optim::Optimizer& optimizer,
-                                      ObservationPipeline& pipeline, at::Generator& generator);
+                                      ObservationPipeline& pipeline, at::Generator& generator,
+                                      const ArchiveReader& check = {});
 
 }  // namespace cradle::learn

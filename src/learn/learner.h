@@ -102,8 +102,8 @@ class Learner {
   virtual void act(const envs::ObservationBuffers& observation, std::span<double> action,
                    bool deterministic) = 0;
   // The expected discounted return from one observation (curriculum teachers' estimate, SPDL):
-  // PPO's value head, SAC's min_i Q_i(s, tanh(mean(s))); NaN for a learner without one. Does not
-  // update the observation statistics.
+  // PPO's value head, SAC's min_i Q_i(s, tanh(mean(s))), TD3's and DDPG's min_i Q_i(s, mu(s));
+  // NaN for a learner without one. Does not update the observation statistics.
   virtual double value(const envs::ObservationBuffers& /*observation*/) {
     return std::numeric_limits<double>::quiet_NaN();
   }

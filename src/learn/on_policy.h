@@ -26,12 +26,14 @@
 #include <string_view>
 #include <utility>
 
+#include "core/error.h"
 #include "learn/checkpoint.h"
 #include "learn/grad_sync.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/networks.h"
 #include "learn/preprocess.h"
+#include "learn/return_normalizer.h"
 #include "learn/rollout.h"
 
 namespace cradle::learn {
@@ -68,12 +70,31 @@ struct OnPolicyLoop {
   int n_steps = 2048;      // vector steps per env per rollout
   double gamma = 0.99, gae_lambda = 0.95;
   long report_every = 1;  // rollouts (and updates) per progress report
+  // Rewards scaled by the return normaliser (learn/return_normalizer.h), after the reward hook.
+  bool normalize_returns = false;
 };
 
 // Standardised advantages: (A - mean) / (std + 1e-8).
 inline torch::Tensor standardize(const torch::Tensor& advantages) {
   return (advantages - advantages.mean()) / (advantages.std() + 1e-8);
 }
+
+// The return normaliser of loop.normalize_returns (null when off). UserError for an async vector
+// env (its hook sees batches, not fixed env indices) or a data-parallel run (each rank would
+// scale by its own statistics).
+std::unique_ptr<ReturnNormalizer> make_return_normalizer(const OnPolicyLoop& loop,
+                                                         const VecEnv& env,
+                                                         const LearnerOptions& options);
+// `first` (may be empty), then the normaliser's scaling (when given), as one hook.
+RewardHook chain_reward_hooks(RewardHook first, ReturnNormalizer* returns);
+// UserError unless a checkpoint's config text says normalize_returns = `wanted` (a checkpoint of
+// an earlier build, without the key, holds no return statistics).
+void check_saved_normalize_returns(const std::string& config, bool wanted);
+// The statistics as a checkpoint entry "return_normalizer" (mean, var, count as float64).
+void write_return_statistics(torch::serialize::OutputArchive& archive,
+                             const ReturnNormalizer& returns);
+// Reads them back; UserError when the checkpoint has none or they are malformed.
+ReturnStatistics read_return_statistics(torch::serialize::InputArchive& archive);
 
 // The learner skeleton. An algorithm builds its optimiser on parameters() in its constructor,
 // hands it to use_optimizer(), and implements update().
@@ -91,6 +112,7 @@ class OnPolicyLearner : public Learner {
     const Clock::time_point start = Clock::now();
     const long start_steps = steps_;
     collector_.start(draw_env_seed(generator_));
+    if (returns_) returns_->start();
     long iteration = 0;
     std::map<std::string, double> sums;              // of the updates since the last report
     double collect_seconds = 0, update_seconds = 0;  // since the last report
@@ -142,15 +164,29 @@ class OnPolicyLearner : public Learner {
 
   void save(const std::filesystem::path& file) const override {
     save_policy_checkpoint(file, {.algorithm = algorithm_, .config = text_, .steps = steps_},
-                           *policy_, *optimizer_, pipeline_, generator_);
+                           *policy_, *optimizer_, pipeline_, generator_,
+                           [this](torch::serialize::OutputArchive& archive) {
+                             if (returns_) write_return_statistics(archive, *returns_);
+                           });
   }
 
+  // A checkpoint saved with other return normalisation is refused: its value head learned
+  // returns of another scale.
   void load(const std::filesystem::path& file) override {
+    ReturnStatistics statistics;
+    const auto check = [&](const CheckpointInfo& header, torch::serialize::InputArchive& archive) {
+      check_saved_normalize_returns(header.config, returns_ != nullptr);
+      if (returns_) statistics = read_return_statistics(archive);
+    };
     steps_ = load_policy_checkpoint(file, algorithm_, observation_, *policy_, *optimizer_,
-                                    pipeline_, generator_)
+                                    pipeline_, generator_, check)
                  .steps;
+    if (returns_) returns_->set_statistics(statistics);
     offset_generator(sync_.get(), generator_);
   }
+
+  // The return normaliser's statistics (null: normalize_returns is off).
+  const ReturnNormalizer* return_normalizer() const { return returns_.get(); }
 
   std::uint64_t parameter_hash() const override { return tensor_hash({parameters_.tensor()}); }
 
@@ -179,7 +215,8 @@ class OnPolicyLearner : public Learner {
         policy_(pipeline_.shape(), env.action_space().size(), policy, generator_),
         parameters_(*policy_),
         buffer_(loop.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
-        collector_(env, pipeline_, options.reward_hook),
+        returns_(make_return_normalizer(loop, env, options)),
+        collector_(env, pipeline_, chain_reward_hooks(options.reward_hook, returns_.get())),
         scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
         update_threads_(update_threads(options, pipeline_.shape())),
         sync_(options.sync) {
@@ -223,6 +260,7 @@ class OnPolicyLearner : public Learner {
   PackedParameters parameters_;                   // policy_'s parameters, packed for the optimiser
   torch::optim::Optimizer* optimizer_ = nullptr;  // the algorithm's, on parameters_
   RolloutBuffer buffer_;
+  std::unique_ptr<ReturnNormalizer> returns_;  // null: normalize_returns off
   RolloutCollector collector_;
   ObsBatch scratch_;  // one row, for act()
   const int update_threads_;

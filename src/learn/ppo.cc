@@ -37,6 +37,8 @@ void PpoConfig::bind(Hyperparameters& table) {
   table.add("max_grad_norm", &max_grad_norm, "gradient norm clip");
   table.add("target_kl", &target_kl, "early stop at approx KL > 1.5 x this (<= 0: off)");
   table.add("adam_eps", &adam_eps, "Adam epsilon");
+  table.add("normalize_returns", &normalize_returns,
+            "divide rewards by the running std of the discounted return, clip +-10");
 }
 
 namespace {
@@ -66,7 +68,8 @@ class Ppo final : public OnPolicyLearner {
                          .anneal_lr = settings.own.anneal_lr,
                          .n_steps = settings.own.n_steps,
                          .gamma = settings.own.gamma,
-                         .gae_lambda = settings.own.gae_lambda},
+                         .gae_lambda = settings.own.gae_lambda,
+                         .normalize_returns = settings.own.normalize_returns},
                         settings.observation, settings.policy, settings.text),
         config_(settings.own),
         optimizer_(std::vector<torch::Tensor>{parameters().tensor()},

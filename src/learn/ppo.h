@@ -32,6 +32,9 @@ struct PpoConfig {
   // disables it (SB3 target_kl=None).
   double target_kl = 0.0;
   double adam_eps = 1e-5;  // Adam epsilon (SB3 sets 1e-5 for its policies' Adam)
+  // Train on rewards divided by the running std of the discounted return, clipped to +-10
+  // (VecNormalize norm_reward; learn/return_normalizer.h). Its statistics are checkpointed.
+  bool normalize_returns = false;
 
   void bind(Hyperparameters& table);
 };

@@ -137,6 +137,11 @@ class Td3 final : public OffPolicyLearner {
         }};
   }
 
+  // Q(s, mu(s)), the minimum over the critics (as the targets, and as SAC's value; DDPG has one).
+  torch::Tensor state_value(const ObsBatch& observation) override {
+    return std::get<0>(critic_->forward(observation, actor_->forward(observation)).min(0));
+  }
+
   void train(const ReplayBuffer::Sample& batch, long update) override {
     // Target: the target actor's smoothed action, the minimum of the target critics.
     torch::Tensor target;

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <span>
 #include <sstream>
 
 #include "core/error.h"
@@ -81,44 +80,73 @@ void cut_back(const fs::path& file, std::uintmax_t size) {
             << "\n";
 }
 
-// VecNormalize's return normalisation (Baselines' ppo2 as TeachMyAgent runs it): each env keeps
-// its discounted return ret = gamma ret + r (zeroed when an episode ends), a running variance of
-// ret over every step, and the learner trains on r / sqrt(var + 1e-8) clipped to +-10. Autoreset
-// steps (no transition) neither add to ret nor to the statistics. Its statistics start afresh in
-// every process (a resumed run does not restore them).
-class ReturnNormalizer {
- public:
-  explicit ReturnNormalizer(double gamma) : gamma_(gamma) {}
-  void operator()(const learn::VecEnv& env, std::span<const double>, std::span<double> rewards) {
-    const int n = env.num_envs();
-    if (ret_.empty()) {
-      ret_.assign(n, 0.0);
-      ended_.assign(n, 0);
-    }
-    for (int i = 0; i < n; ++i) {
-      if (ended_[i]) {  // this step only reset the env
-        ended_[i] = 0;
-        continue;
-      }
-      ret_[i] = gamma_ * ret_[i] + rewards[i];
-      // Running mean and variance (Chan et al.'s merge of one sample), count starting at 1e-4.
-      const double delta = ret_[i] - mean_, total = count_ + 1;
-      mean_ += delta / total;
-      var_ = (var_ * count_ + delta * delta * count_ / total) / total;
-      count_ = total;
-      rewards[i] = std::clamp(rewards[i] / std::sqrt(var_ + 1e-8), -10.0, 10.0);
-      if (env.terminated()[i] || env.truncated()[i]) {
-        ret_[i] = 0;
-        ended_[i] = 1;
-      }
-    }
+// Splits a CSV line of plain cells (our logs hold numbers and names, never quotes).
+std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::size_t at = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', at);
+    cells.push_back(line.substr(at, comma == std::string::npos ? comma : comma - at));
+    if (comma == std::string::npos) return cells;
+    at = comma + 1;
   }
+}
 
- private:
-  double gamma_, mean_ = 0, var_ = 1, count_ = 1e-4;
-  std::vector<double> ret_;
-  std::vector<std::uint8_t> ended_;
-};
+// A log written by a binary with other columns (an older one: fewer) under the current `header`.
+// When every old column is among the current ones, the file is rewritten in place: each row's
+// cells move under their column's name and the columns the old binary lacked stay empty, so one
+// CSV holds the whole run and nothing is lost. Otherwise (a column would be dropped, or a row
+// does not fit its header) the file is kept whole as <stem>.before-resume[-k]<ext> and a fresh
+// one begins. Returns whether the file still needs its header (kept aside or missing); prints one
+// line when it changed anything.
+bool adopt_header(const fs::path& file, const std::string& header) {
+  std::ifstream in(file);
+  std::string first;
+  if (!in || !std::getline(in, first)) return true;
+  if (first == header) return false;
+  const std::vector<std::string> now = split_cells(header), old = split_cells(first);
+  std::vector<int> where(old.size(), -1);  // each old column's index in the current header
+  bool fits = true;
+  for (std::size_t c = 0; c < old.size(); ++c) {
+    const auto it = std::find(now.begin(), now.end(), old[c]);
+    if (it == now.end())
+      fits = false;
+    else
+      where[c] = static_cast<int>(it - now.begin());
+  }
+  std::ostringstream text;
+  text << header << "\n";
+  for (std::string line; fits && std::getline(in, line);) {
+    const std::vector<std::string> cells = split_cells(line);
+    if (cells.size() != old.size()) {
+      fits = false;
+      break;
+    }
+    std::vector<std::string> row(now.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) row[where[c]] = cells[c];
+    for (std::size_t c = 0; c < row.size(); ++c) text << (c ? "," : "") << row[c];
+    text << "\n";
+  }
+  in.close();
+  if (fits) {
+    write_atomically(file, text.str());
+    std::cerr << file.filename().string() << ": rows of an older header rewritten under the "
+              << "current one (new columns empty)\n";
+    return false;
+  }
+  fs::path kept;
+  for (int k = 1; k == 1 || fs::exists(kept); ++k) {
+    kept =
+        file.parent_path() / (file.stem().string() + ".before-resume" +
+                              (k > 1 ? "-" + std::to_string(k) : "") + file.extension().string());
+  }
+  std::error_code ec;
+  fs::rename(file, kept, ec);
+  if (ec) throw UserError("cannot rename '" + file.string() + "': " + ec.message());
+  std::cerr << file.filename().string() << ": written with other columns, kept as " << kept.string()
+            << "\n";
+  return true;
+}
 
 // The teacher's build: the registry's setup from the run's options and the env's facts.
 std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const StudentRunOptions& o,
@@ -141,8 +169,6 @@ std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const St
 }
 
 }  // namespace
-
-learn::RewardHook return_normalizer(double gamma) { return ReturnNormalizer(gamma); }
 
 std::map<std::string, std::string> student_preset(const std::string& student, long total_steps) {
   // SpinningUp SAC as TeachMyAgent runs it (spec §4.1).
@@ -247,27 +273,9 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   // The student; a reset gives a fresh one (criterion 3) with its own seed.
   long offset = 0;
   int student_resets = 0;
-  // normalize_returns is the run's (a reward hook), not the learner's.
-  std::map<std::string, std::string> learner_hp = hyperparameters;
-  bool normalize_returns = false;
-  if (const auto it = learner_hp.find("normalize_returns"); it != learner_hp.end()) {
-    if (it->second != "true" && it->second != "false")
-      throw UserError("--hp normalize_returns=" + it->second + " (expected true or false)");
-    normalize_returns = it->second == "true";
-    learner_hp.erase(it);
-  }
-  double gamma = 0.99;
-  if (learner_hp.contains("gamma")) {
-    try {
-      gamma = std::stod(learner_hp.at("gamma"));
-    } catch (const std::exception&) {
-      // The learner names the bad value.
-    }
-  }
   auto make_student = [&] {
     learn::LearnerOptions lo{.seed = o.seed + 7919 * static_cast<std::uint64_t>(student_resets),
-                             .hyperparameters = learner_hp};
-    if (normalize_returns) lo.reward_hook = return_normalizer(gamma);
+                             .hyperparameters = hyperparameters};
     return learn::make_learner(o.student, vec, lo);
   };
   std::unique_ptr<learn::Learner> learner = make_student();
@@ -337,15 +345,29 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   }
   auto run_steps = [&] { return offset + learner->steps(); };
 
-  // The logs: appended to on resume (already cut back), fresh otherwise.
-  std::ofstream progress(dir / "progress.csv", o.resume ? std::ios::app : std::ios::trunc);
-  std::ofstream test_csv(dir / "test_returns.csv", o.resume ? std::ios::app : std::ios::trunc);
+  // The logs: appended to on resume (already cut back; an older binary's columns adopted, and
+  // the checkpoint's sizes then follow the rewritten files), fresh otherwise.
+  bool progress_header = true, test_header = true;
+  if (o.resume) {
+    progress_header = adopt_header(dir / "progress.csv", kProgressHeader);
+    test_header = adopt_header(dir / "test_returns.csv", kTestHeader);
+    nlohmann::json sizes = state["sizes"];
+    for (const char* name : {"progress.csv", "test_returns.csv"}) {
+      std::error_code ec;
+      const std::uintmax_t size = fs::exists(dir / name, ec) ? fs::file_size(dir / name, ec) : 0;
+      sizes[name] = size;
+    }
+    if (sizes != state["sizes"]) {
+      state["sizes"] = sizes;
+      write_atomically(state_file, state.dump(2) + "\n");
+    }
+  }
+  std::ofstream progress(dir / "progress.csv", progress_header ? std::ios::trunc : std::ios::app);
+  std::ofstream test_csv(dir / "test_returns.csv", test_header ? std::ios::trunc : std::ios::app);
   if (!progress || !test_csv)
     throw UserError("cannot write the run's logs in '" + dir.string() + "'");
-  if (!o.resume) {
-    progress << kProgressHeader << "\n";
-    test_csv << kTestHeader << "\n";
-  }
+  if (progress_header) progress << kProgressHeader << "\n";
+  if (test_header) test_csv << kTestHeader << "\n";
   JsonlWriter teacher_log(dir / "teacher.jsonl", o.resume);
 
   int evaluation = o.resume ? state["evaluation"].get<int>() + 1 : 0;

@@ -69,11 +69,6 @@ struct StudentRunResult {
   double last_pct_mastered = 0;
 };
 
-// VecNormalize's return normalisation as a reward hook: every reward divided by the running
-// standard deviation of the discounted return (gamma), clipped to +-10; the PPO preset's
-// normalize_returns = true.
-learn::RewardHook return_normalizer(double gamma);
-
 // The reference presets (spec tma_sami.md §4.1, §4.2) as learner hyperparameters; total_steps caps
 // SAC's replay buffer (it never overwrites within the run either way). UserError for another
 // student.

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/jsonl.h"
 #include "envs/babybench.h"
+#include "envs/mimo/sample_env.h"
 #include "eval/figures.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
@@ -25,6 +26,7 @@
 #include "train/babybench_vector.h"
 #include "train/curriculum_env.h"
 #include "train/loop.h"
+#include "train/sample_vector.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -136,6 +138,19 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (options.steps < 1) throw UserError("--steps must be at least 1");
   if (options.envs < 1) throw UserError("--envs must be at least 1");
   if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
+  // A sample env has none of BabyBench's extras.
+  const bool sample = !options.env.empty();
+  if (sample) {
+    envs::sample_env_id(options.env);  // UserError for an unknown name
+    if (!options.intrinsic.empty())
+      throw UserError("--intrinsic is for BabyBench configs; --env " + options.env +
+                      " trains on the sample task's own reward");
+    if (options.randomize_start || options.compare_random)
+      throw UserError(
+          "--randomize-start and --compare-random are for BabyBench configs, not --env");
+    if (distributed(options.sync.get()))
+      throw UserError("--distributed trains BabyBench configs, not --env");
+  }
   const fs::path dir = config.save_dir;
   const fs::path checkpoints = dir / "checkpoints";
   const fs::path latest = checkpoints / "latest.ckpt";
@@ -183,9 +198,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (rank > 0) env_config.save_dir = (dir / "ranks" / std::to_string(rank)).string();
   const fs::path log_file = fs::path(env_config.save_dir) / "logs" / "training.jsonl";
   const long kept_episodes =
-      options.resume ? cut_training_log(log_file, rank == 0 ? resumed.episodes
-                                                            : std::numeric_limits<long>::max())
-                     : -1;
+      options.resume && !sample
+          ? cut_training_log(log_file,
+                             rank == 0 ? resumed.episodes : std::numeric_limits<long>::max())
+          : -1;
 
   // A curriculum wraps every env: the teacher sets its reset options before each reset.
   const fs::path teacher_file = fs::path(env_config.save_dir) / "logs" / "teacher.jsonl";
@@ -226,8 +242,15 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     teacher_log->flush();
   };
   // A resumed run's first resets end no episode of this run's log.
-  TrainingVector training = make_babybench_training(env_config, options.envs, options.threads,
-                                                    options.seed + rank, kept_episodes, wrap);
+  if (sample) {
+    std::error_code made;
+    fs::create_directories(dir / "logs", made);
+    if (made) throw UserError("cannot create '" + (dir / "logs").string() + "': " + made.message());
+  }
+  TrainingVector training =
+      sample ? make_sample_training(options.env, options.envs, options.threads, options.seed, wrap)
+             : make_babybench_training(env_config, options.envs, options.threads,
+                                       options.seed + rank, kept_episodes, wrap);
   std::unique_ptr<ThreadedVecEnv>& vec = training.vec;
   for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
     vec->env(i).set_reset_options({{"randomize_start", 1}});
@@ -278,8 +301,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // episodes exactly as a resumed run does.
   auto save_checkpoint = [&](const std::vector<fs::path>& files) {
     training.end_episodes();
-    training_log->flush();
-    const RunState run{.steps = learner->steps(), .episodes = training_log->episodes()};
+    if (training_log) training_log->flush();
+    const RunState run{.steps = learner->steps(),
+                       .episodes = training_log ? training_log->episodes() : 0};
     if (rank > 0) return;  // rank 0 writes the run's checkpoints
     for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
   };
@@ -349,8 +373,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
 
+    // A sample env has no behaviour score.
     bar.show(s.steps, elapsed,
-             "return " + csv_cell(s.episodic_return) + "  score " + csv_cell(last_score));
+             "return " + csv_cell(s.episodic_return) +
+                 (sample ? "" : "  score " + csv_cell(last_score)));
     return true;
   };
   // Learning stops at each checkpoint (an episode boundary) and continues in a new learn() call.
@@ -392,12 +418,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (rank > 0) return result;  // rank 0 draws, scores and evaluates the run
   if (!rows.empty()) plot_curves(rows, dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
-  if (fs::exists(log_file))
+  if (!sample && fs::exists(log_file))
     result.training_score = eval::training_score(
         config.behavior, eval::read_training_log(log_file, config.behavior, training.geom_count));
 
   // The trained policy's evaluation, acting deterministically.
-  if (options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
+  if (!sample && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
     train::EvaluationOptions eo{.episodes = options.eval_episodes,
                                 .duration = options.eval_duration,
                                 .render = options.eval_render,

@@ -19,6 +19,10 @@
 namespace cradle::train {
 
 struct TrainOptions {
+  // A MIMo sample env (reach, standup, selfbody, catch) instead of the config's BabyBench env: the
+  // same loop, checkpoints, progress.csv and curriculum, without BabyBench's training log,
+  // intrinsic rewards (intrinsic must be empty), start randomisation and final evaluation.
+  std::string env;
   // With resume: empty continues the checkpoint's algorithm, another name is refused.
   std::string algorithm = "ppo";
   std::string intrinsic = "body_part_novelty";  // "name[:weight],..."; empty: env reward only
@@ -68,6 +72,7 @@ struct TrainResult {
   std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };
 
+// With options.env set, only config.save_dir is read.
 TrainResult train(const Config& config, const TrainOptions& options);
 
 // The policy of a checkpoint, for `cradle evaluate --policy`: the mean action, or with `sampled`

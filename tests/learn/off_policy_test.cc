@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "learn/checkpoint.h"
 #include "learn/registry.h"
 #include "learn/replay_buffer.h"
 #include "test_tasks.h"
@@ -406,6 +407,60 @@ TEST(Sac, ValueIsTheCriticAtTheDeterministicActionAndRises) {
   EXPECT_EQ(sac->value(start), before);
   sac->learn(1500, [](const TrainStats&) { return true; });
   EXPECT_GT(sac->value(start), before + 3.0);
+}
+
+TEST(Td3, ValueIsTheMinimumCriticAtTheActorsAction) {
+  // TD3 and DDPG (SPDL's value estimate): min_i Q_i(s, mu(s)), as SAC's. The critic is read
+  // back from a checkpoint into a network of the same shape and evaluated at the action the
+  // learner takes deterministically; a few updates first move the critics off their targets.
+  const std::map<std::string, std::string> hp = {{"learning_starts", "20"},
+                                                 {"batch_size", "8"},
+                                                 {"pi_layers", "8"},
+                                                 {"qf_layers", "8"},
+                                                 {"normalize_observations", "false"}};
+  for (const std::string algorithm : {"td3", "ddpg"}) {
+    SCOPED_TRACE(algorithm);
+    auto env = make_scripted({7}, /*bound=*/1.0);
+    auto learner = make_learner(algorithm, *env, {.seed = 5, .hyperparameters = hp});
+    learner->learn(120, [](const TrainStats&) { return true; });
+    const std::filesystem::path file =
+        std::filesystem::temp_directory_path() / ("cradle_" + algorithm + "_value.ckpt");
+    learner->save(file);
+    ObservationPipeline pipeline(env->observation_space(), {.normalize_observations = false},
+                                 nullptr);
+    at::Generator unused = at::make_generator<at::CPUGeneratorImpl>(0);
+    const int critics = algorithm == "td3" ? 2 : 1;
+    OffPolicyNetworkConfig networks;
+    networks.pi_layers = {8};
+    networks.qf_layers = {8};
+    Critic critic(pipeline.shape(), 1, critics, networks, unused);
+    read_checkpoint(file, algorithm,
+                    [&](const CheckpointInfo&, torch::serialize::InputArchive& archive) {
+                      read_module(archive, "critic", *critic);
+                    });
+    std::filesystem::remove(file);
+
+    env->reset(3);
+    int differ = 0;
+    for (int t = 0; t < 5; ++t) {
+      const envs::ObservationBuffers& observation = env->observation(0);
+      std::vector<double> action(1);
+      learner->act(observation, action, /*deterministic=*/true);
+      ObsBatch batch = ObsBatch::zeros(pipeline.shape(), 1);
+      pipeline.process(observation, batch);
+      torch::NoGradGuard no_grad;
+      const torch::Tensor q =
+          critic->forward(batch, torch::tensor({{static_cast<float>(action[0])}}));
+      ASSERT_EQ(q.size(0), critics);
+      const double expected = q.min().item<double>();
+      EXPECT_NEAR(learner->value(observation), expected, 1e-5 * (1 + std::fabs(expected)));
+      if (critics == 2) differ += q[0].item<double>() != q[1].item<double>();
+      env->step(action);
+    }
+    if (critics == 2) {
+      EXPECT_GT(differ, 0);  // the minimum is not a formality
+    }
+  }
 }
 
 TEST(Sac, DeterministicGivenTheSeed) {

