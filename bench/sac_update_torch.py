@@ -15,20 +15,15 @@ same go, alternating with the Python timings, and the ratio is printed (its obs_
 import argparse
 import json
 import math
-import statistics
 import subprocess
-import time
 
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from side_by_side import TwinCritics, alternate, medians, squashed_sample, time_steps
+
 ACTIONS, HIDDEN, BATCH, REPLAY = 44, 256, 256, 512
-
-
-def mlp(inp, out):
-    return nn.Sequential(nn.Linear(inp, HIDDEN), nn.ReLU(), nn.Linear(HIDDEN, HIDDEN), nn.ReLU(),
-                         nn.Linear(HIDDEN, out))
 
 
 class Actor(nn.Module):
@@ -41,22 +36,11 @@ class Actor(nn.Module):
 
     def sample(self, s):
         h = self.latent(s)
-        mean, log_std = self.mean(h), self.log_std(h).clamp(-20, 2)
-        eps = torch.randn_like(mean)
-        u = mean + log_std.exp() * eps
-        log_gauss = -0.5 * eps.square() - log_std - 0.5 * math.log(2 * math.pi)
-        log_jac = 2 * (math.log(2) - u - F.softplus(-2 * u))
-        return torch.tanh(u), (log_gauss - log_jac).sum(1)
+        return squashed_sample(self.mean(h), self.log_std(h))
 
 
-class SeparateCritics(nn.Module):
-    def __init__(self, obs):
-        super().__init__()
-        self.q = nn.ModuleList([mlp(obs + ACTIONS, 1) for _ in range(2)])
-
-    def forward(self, s, a):
-        x = torch.cat([s, a], 1)
-        return torch.stack([q(x).squeeze(1) for q in self.q])
+def separate_critics(obs):
+    return TwinCritics(obs, ACTIONS, [HIDDEN, HIDDEN])
 
 
 class FusedCritics(nn.Module):
@@ -82,7 +66,7 @@ class FusedCritics(nn.Module):
 
 class Sac:
     def __init__(self, obs, fused):
-        critic = FusedCritics if fused else SeparateCritics
+        critic = FusedCritics if fused else separate_critics
         self.actor, self.critic, self.target = Actor(obs), critic(obs), critic(obs)
         self.target.load_state_dict(self.critic.state_dict())
         self.log_alpha = torch.zeros(1, requires_grad=True)
@@ -139,14 +123,7 @@ class Sac:
 
 def python_rate(obs, fused, threads, seconds):
     torch.set_num_threads(threads)
-    sac = Sac(obs, fused)
-    for _ in range(3):
-        sac.step()
-    steps, t0, c0 = 0, time.perf_counter(), time.process_time()
-    while time.perf_counter() - t0 < seconds:
-        sac.step()
-        steps += 1
-    return steps / (time.perf_counter() - t0), 1000 * (time.process_time() - c0) / steps
+    return time_steps(Sac(obs, fused).step, warmup=3, seconds=seconds)
 
 
 def cradle_rates(binary, seconds):
@@ -171,31 +148,34 @@ def main():
     ap.add_argument("--rounds", type=int, default=3, help="alternations C++ / Python")
     ap.add_argument("--cradle-bench", default="", help="build/cradle_bench: time it in the same go")
     args = ap.parse_args()
-    table = {}  # (who, threads) -> [rates]
-    obs = args.obs_dim
-    for _ in range(args.rounds):
-        if args.cradle_bench:
-            for threads, (rate, cpu, dim) in cradle_rates(args.cradle_bench, args.seconds).items():
-                table.setdefault(("cradle (fused)", threads), []).append((rate, cpu))
-                obs = obs or dim
-        obs = obs or 500
-        for threads in args.threads:
-            for fused in (False, True):
-                who = "torch fused" if fused else "torch separate (SB3)"
-                table.setdefault((who, threads), []).append(
-                    python_rate(obs, fused, threads, args.seconds))
-    print(f"SAC gradient step, obs {obs}, action {ACTIONS}, 256-256, batch {BATCH}: "
+    obs = [args.obs_dim]  # the C++ benchmark's obs_dim when not given, else 500
+
+    def cradle():
+        rates = {}
+        for threads, (rate, cpu, dim) in cradle_rates(args.cradle_bench, args.seconds).items():
+            rates[("cradle (fused)", threads)] = (rate, cpu)
+            obs[0] = obs[0] or dim
+        return rates
+
+    def python():
+        obs[0] = obs[0] or 500
+        return {("torch fused" if fused else "torch separate (SB3)", threads):
+                python_rate(obs[0], fused, threads, args.seconds)
+                for threads in args.threads for fused in (False, True)}
+
+    table = alternate(args.rounds, [cradle, python] if args.cradle_bench else [python])
+    print(f"SAC gradient step, obs {obs[0]}, action {ACTIONS}, 256-256, batch {BATCH}: "
           f"median of {args.rounds} rounds; wall and CPU time per step (CPU: robust to a loaded "
           f"machine)")
     for (who, threads), runs in sorted(table.items(), key=lambda kv: (kv[0][1], kv[0][0])):
-        rate = statistics.median(r for r, _ in runs)
-        cpu = statistics.median(c for _, c in runs)
+        rate, cpu = medians(runs)
         line = (f"  threads {threads}  {who:22s} {rate:7.1f}/s  wall {1000 / rate:7.2f} ms  "
                 f"cpu {cpu:7.2f} ms")
         base = table.get(("torch separate (SB3)", threads))
         if base and who != "torch separate (SB3)":
-            line += (f"  speed x{rate / statistics.median(r for r, _ in base):.2f}, cpu "
-                     f"x{statistics.median(c for _, c in base) / cpu:.2f} of torch separate")
+            base_rate, base_cpu = medians(base)
+            line += (f"  speed x{rate / base_rate:.2f}, cpu x{base_cpu / cpu:.2f} of torch "
+                     f"separate")
         print(line)
 
 

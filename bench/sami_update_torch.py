@@ -2,26 +2,18 @@
 """SaCCM's gradient step in PyTorch (Debian's python3-torch), the side-by-side of
 bench/sami_update_bench.cc: the same networks (actor and twin critics 512-512-512, LSTM 128 without
 biases -> ReLU -> Linear 6, target copies), the same batch shapes, SAC with contexts and the
-weighted SaNCE step of the `half` sampler. Prints gradient steps/s per setting and thread count.
+weighted SaNCE step of the `half` sampler. Prints gradient steps/s per setting and thread count
+(the median of --rounds rounds, the settings alternating within each round).
 
-    /usr/bin/python3 bench/sami_update_torch.py [--iterations 5] [--threads 1 2]
+    /usr/bin/python3 bench/sami_update_torch.py [--iterations 5] [--threads 1 2] [--rounds 1]
 """
 import argparse
-import math
-import time
 
 import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-
-def mlp(inp, layers, out):
-    mods, last = [], inp
-    for h in layers:
-        mods += [nn.Linear(last, h), nn.ReLU()]
-        last = h
-    mods.append(nn.Linear(last, out))
-    return nn.Sequential(*mods)
+from side_by_side import TwinCritics, alternate, medians, mlp, squashed_sample, time_steps
 
 
 class Encoder(nn.Module):
@@ -43,22 +35,7 @@ class Actor(nn.Module):
 
     def sample(self, x):
         h = F.relu(self.latent(x))
-        mean, log_std = self.mean(h), self.log_std(h).clamp(-20, 2)
-        eps = torch.randn_like(mean)
-        u = mean + log_std.exp() * eps
-        log_gauss = -0.5 * eps.square() - log_std - 0.5 * math.log(2 * math.pi)
-        log_jac = 2 * (math.log(2) - u - F.softplus(-2 * u))
-        return torch.tanh(u), (log_gauss - log_jac).sum(1)
-
-
-class Critic(nn.Module):
-    def __init__(self, inp, act, layers):
-        super().__init__()
-        self.q = nn.ModuleList([mlp(inp + act, layers, 1) for _ in range(2)])
-
-    def forward(self, s, a):
-        x = torch.cat([s, a], 1)
-        return torch.stack([q(x).squeeze(1) for q in self.q])
+        return squashed_sample(self.mean(h), self.log_std(h))
 
 
 def sance(q, kp, kn, mp, mn, tau=0.1):
@@ -88,7 +65,8 @@ class Setup:
         self.enc_t.load_state_dict(self.enc.state_dict())
         self.w = nn.Linear(ctx, ctx, bias=False)
         self.actor = Actor(obs + ctx, act, [512, 512, 512])
-        self.critic, self.critic_t = Critic(obs + ctx, act, [512] * 3), Critic(obs + ctx, act, [512] * 3)
+        self.critic = TwinCritics(obs + ctx, act, [512] * 3)
+        self.critic_t = TwinCritics(obs + ctx, act, [512] * 3)
         self.critic_t.load_state_dict(self.critic.state_dict())
         for p in list(self.enc_t.parameters()) + list(self.critic_t.parameters()):
             p.requires_grad_(False)
@@ -197,20 +175,24 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--iterations", type=int, default=5)
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--rounds", type=int, default=1, help="alternations of all the settings")
     args = ap.parse_args()
     torch.manual_seed(0)
     print(f"torch {torch.__version__}")
-    for name, setup in [("panda_256x50", (6, 256, 50, 25, 4)), ("mujoco_16x1000", (4, 16, 1000, 18, 6))]:
-        for threads in args.threads:
+    settings = [("panda_256x50", (6, 256, 50, 25, 4)), ("mujoco_16x1000", (4, 16, 1000, 18, 6))]
+
+    def measure(name, setup, threads):
+        def run():
             torch.set_num_threads(threads)
-            s = Setup(*setup)
-            s.update()  # warm-up
-            t0 = time.perf_counter()
-            for _ in range(args.iterations):
-                s.update()
-            dt = time.perf_counter() - t0
-            print(f"{name}/threads:{threads}  {1000 * dt / args.iterations:.0f} ms/step  "
-                  f"{args.iterations / dt:.3f} gradient steps/s")
+            rate = time_steps(Setup(*setup).update, warmup=1, iterations=args.iterations)
+            return {f"{name}/threads:{threads}": rate}
+        return run
+
+    table = alternate(args.rounds, [measure(name, setup, threads) for name, setup in settings
+                                    for threads in args.threads])
+    for key, runs in table.items():
+        rate, cpu = medians(runs)
+        print(f"{key}  {1000 / rate:.0f} ms/step  {rate:.3f} gradient steps/s  cpu {cpu:.0f} ms/step")
 
 
 if __name__ == "__main__":

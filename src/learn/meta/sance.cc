@@ -11,8 +11,9 @@ torch::Tensor embeddings(const torch::Tensor& x, const torch::Tensor& mask,
                          const torch::Tensor& bilinear) {
   torch::Tensor flat = (x * mask.unsqueeze(2)).reshape({-1, x.size(2)});
   if (bilinear.defined()) flat = torch::matmul(flat, bilinear.t());
-  return torch::nn::functional::normalize(flat,
-                                          torch::nn::functional::NormalizeFuncOptions().dim(1));
+  // F.normalize's own sum (x / max(|x|, 1e-12) per row), written out: copying its options (an
+  // optional<Tensor> inside) is a -Wmaybe-uninitialized error of GCC 12 in the -O1 sanitizer build.
+  return flat / flat.norm(2, 1, true).clamp_min(1e-12);
 }
 
 }  // namespace

@@ -463,8 +463,10 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
     const torch::Tensor x =
         torch::from_blob(context_values.data(), {rows, config.context_size}).to(torch::kFloat64);
     const torch::Tensor centred = x - x.mean(0, true);
-    const auto [u, sv, vh] = torch::linalg::svd(centred, /*full_matrices=*/false, c10::nullopt);
-    pcs = torch::matmul(centred, vh.narrow(0, 0, std::min<long>(2, vh.size(0))).t());
+    // torch::svd (LibTorch's linalg_svd, V untransposed): copying linalg::svd's empty driver
+    // optional is a -Wmaybe-uninitialized error of GCC 12 in the -O1 sanitizer build.
+    const auto [u, sv, v] = torch::svd(centred, /*some=*/true);
+    pcs = torch::matmul(centred, v.narrow(1, 0, std::min<long>(2, v.size(1))));
     if (pcs.size(1) < 2) pcs = torch::cat({pcs, torch::zeros({rows, 1}, torch::kFloat64)}, 1);
   }
   const torch::Tensor pc = pcs.to(torch::kFloat64).contiguous();
