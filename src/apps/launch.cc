@@ -75,12 +75,25 @@ int launch(int nproc, int port, const std::string& addr, double grace,
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
 
-  // Start every rank with the rendezvous in its environment.
+  // Start every rank with the rendezvous in its environment. SIGINT and SIGTERM stay blocked
+  // across fork: a child that got one before its exec would run our forwarding handler and live
+  // on; it resets them to the default first, so a pending stop ends it as soon as it unblocks.
+  sigset_t stops, previous;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigprocmask(SIG_BLOCK, &stops, &previous);
   std::vector<Rank> ranks(nproc);
   for (int r = 0; r < nproc; ++r) {
     const pid_t pid = fork();
-    if (pid < 0) throw UserError("cradle launch: cannot start rank " + std::to_string(r));
+    if (pid < 0) {
+      sigprocmask(SIG_SETMASK, &previous, nullptr);
+      throw UserError("cradle launch: cannot start rank " + std::to_string(r));
+    }
     if (pid == 0) {
+      signal(SIGINT, SIG_DFL);
+      signal(SIGTERM, SIG_DFL);
+      sigprocmask(SIG_SETMASK, &previous, nullptr);
       setenv("WORLD_SIZE", std::to_string(nproc).c_str(), 1);
       setenv("RANK", std::to_string(r).c_str(), 1);
       setenv("LOCAL_RANK", std::to_string(r).c_str(), 1);
@@ -96,6 +109,7 @@ int launch(int nproc, int port, const std::string& addr, double grace,
     }
     ranks[r] = {.pid = pid, .running = true};
   }
+  sigprocmask(SIG_SETMASK, &previous, nullptr);
   std::fprintf(stderr, "cradle launch: %d ranks, master %s:%d\n", nproc, addr.c_str(), port);
 
   // Wait for them; forward signals; the first failure stops the rest.

@@ -1,5 +1,7 @@
 #include "learn/run_files.h"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -48,10 +50,12 @@ std::vector<std::string_view> split_lines(std::string_view text, std::string_vie
   return lines;
 }
 
-// A staging folder beside `file`, removed when done.
+// A staging folder beside `file`, removed when done; named by the process, because every rank of a
+// distributed run loads the same checkpoint at once.
 struct Staging {
   fs::path dir;
-  explicit Staging(const fs::path& file) : dir(fs::path(file) += ".intrinsic") {
+  explicit Staging(const fs::path& file)
+      : dir(fs::path(file) += ".intrinsic." + std::to_string(getpid())) {
     std::error_code ec;
     fs::remove_all(dir, ec);
     fs::create_directories(dir, ec);

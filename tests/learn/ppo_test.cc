@@ -1,6 +1,7 @@
 // PPO and A2C on the inline CartPole: they learn (mean return far above a random policy's),
 // are deterministic given the seed, and checkpoints restore them exactly.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cmath>
@@ -156,8 +157,12 @@ TEST(Ppo, DeterministicGivenTheSeed) {
 void check_checkpoint(const std::string& algorithm, bool with_image,
                       const std::map<std::string, std::string>& hyperparameters) {
   SCOPED_TRACE(algorithm);
+  // Named by the test and the process: ctest -j runs the tests that call this side by side.
   const std::filesystem::path file =
-      std::filesystem::temp_directory_path() / ("cradle_" + algorithm + "_checkpoint.pt");
+      std::filesystem::temp_directory_path() /
+      ("cradle_" + algorithm + "_" +
+       ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+       std::to_string(getpid()) + "_checkpoint.pt");
   auto env_a = testing::make_cartpoles(2, 30, with_image);
   auto env_b = testing::make_cartpoles(2, 30, with_image);
   auto a = make_learner(algorithm, *env_a, {.seed = 3, .hyperparameters = hyperparameters});
