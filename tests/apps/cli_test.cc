@@ -15,6 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using CliResult = cradle::test::RunResult;
+using cradle::test::read_lines;
 using cradle::test::run_cradle;
 
 std::string config(const char* name) { return cradle::test::config_path(name).string(); }
@@ -25,14 +26,6 @@ int lines(const std::string& s) {
   int n = 0;
   for (char c : s) n += c == '\n';
   return n;
-}
-
-// The lines of a text file.
-std::vector<std::string> read_lines(const fs::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> rows;
-  for (std::string line; std::getline(in, line);) rows.push_back(line);
-  return rows;
 }
 
 // A quick training config in dir/config.yml (self-touch, no vision, 100-step episodes) whose run

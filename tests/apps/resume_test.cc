@@ -23,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 using CliRun = cradle::test::RunResult;
+using cradle::test::read_lines;
 
 CliRun run_shell(const std::string& command) { return cradle::test::run(command + " 2>&1"); }
 
@@ -35,13 +36,6 @@ fs::path temp_dir(const std::string& tag) { return cradle::test::fresh_dir("resu
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::vector<std::string> read_lines(const fs::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> rows;
-  for (std::string line; std::getline(in, line);) rows.push_back(line);
-  return rows;
 }
 
 // Lines of the message without the progress bar (its '[###...]' lines and carriage returns).

@@ -16,15 +16,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using cradle::test::read_lines;
 using cradle::test::run_cradle;
 using cradle::test::RunResult;
-
-std::vector<std::string> lines(const fs::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> out;
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
-}
 
 // The first cell of a CSV line as a number.
 double first_cell(const std::string& line) { return std::stod(line.substr(0, line.find(','))); }
@@ -42,7 +36,7 @@ TEST(TrainEnv, CatchCurriculumTrainsWritesTheBooksAndResumes) {
   EXPECT_NE(r.out.find("trained 512 env steps"), std::string::npos) << r.out;
 
   // progress.csv: one row per update (128 steps), up to 512.
-  std::vector<std::string> progress = lines(dir / "run" / "logs" / "progress.csv");
+  std::vector<std::string> progress = read_lines(dir / "run" / "logs" / "progress.csv");
   ASSERT_EQ(progress.size(), 1u + 4);
   EXPECT_EQ(progress[0].rfind("global_step,time,", 0), 0u);
   EXPECT_EQ(first_cell(progress.back()), 512);
@@ -55,7 +49,7 @@ TEST(TrainEnv, CatchCurriculumTrainsWritesTheBooksAndResumes) {
   auto read_book = [&](long& train, long& dumps) {
     train = 0;
     dumps = 0;
-    for (const std::string& line : lines(dir / "run" / "logs" / "teacher.jsonl")) {
+    for (const std::string& line : read_lines(dir / "run" / "logs" / "teacher.jsonl")) {
       const nlohmann::json j = nlohmann::json::parse(line);
       if (j["kind"] == "train") {
         EXPECT_EQ(j["episode"], train++);
@@ -78,7 +72,7 @@ TEST(TrainEnv, CatchCurriculumTrainsWritesTheBooksAndResumes) {
   // --resume continues the run, the progress rows and the book (episodes numbered on).
   r = run_cradle(args + " --steps 768 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  progress = lines(dir / "run" / "logs" / "progress.csv");
+  progress = read_lines(dir / "run" / "logs" / "progress.csv");
   ASSERT_EQ(progress.size(), 1u + 6);
   EXPECT_EQ(first_cell(progress.back()), 768);
   long more = 0;

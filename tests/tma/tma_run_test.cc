@@ -17,16 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using cradle::test::read_lines;
 using cradle::test::run_cradle;
 using cradle::test::RunResult;
-
-std::vector<std::string> lines(const fs::path& file) {
-  std::ifstream in(file);
-  std::vector<std::string> out;
-  std::string line;
-  while (std::getline(in, line)) out.push_back(line);
-  return out;
-}
 
 std::vector<std::string> cells(const std::string& line) {
   std::vector<std::string> out;
@@ -38,7 +31,7 @@ std::vector<std::string> cells(const std::string& line) {
 
 std::vector<nlohmann::json> jsonl(const fs::path& file) {
   std::vector<nlohmann::json> out;
-  for (const std::string& l : lines(file)) out.push_back(nlohmann::json::parse(l));
+  for (const std::string& l : read_lines(file)) out.push_back(nlohmann::json::parse(l));
   return out;
 }
 
@@ -75,7 +68,7 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_EQ(run["hyperparameters"]["episode_train_freq"], "10");
 
   // progress.csv: evaluations 0 (before training), 1 and 2.
-  std::vector<std::string> progress = lines(dir / "progress.csv");
+  std::vector<std::string> progress = read_lines(dir / "progress.csv");
   ASSERT_EQ(progress.size(), 4u);
   EXPECT_EQ(progress[0],
             "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
@@ -88,11 +81,11 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_GT(episodes, 3);
 
   // test_returns.csv: 4 tasks per evaluation; test_set.csv the 2 x 2 grid.
-  const std::vector<std::string> tests = lines(dir / "test_returns.csv");
+  const std::vector<std::string> tests = read_lines(dir / "test_returns.csv");
   ASSERT_EQ(tests.size(), 1u + 3 * 4);
   EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
   EXPECT_EQ(cells(tests[12])[2], "3");
-  const std::vector<std::string> set = lines(dir / "test_set.csv");
+  const std::vector<std::string> set = read_lines(dir / "test_set.csv");
   ASSERT_EQ(set.size(), 5u);
   EXPECT_EQ(set[0], "task_index,stump_height,obstacle_spacing");
   EXPECT_EQ(set[4], "3,3,6");
@@ -121,13 +114,13 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   std::ofstream(dir / "progress.csv", std::ios::app) << "9,9999,1,1,1,1,1,1,1\n";
   r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_EQ(lines(dir / "progress.after-checkpoint.csv").size(), 1u);
-  progress = lines(dir / "progress.csv");
+  EXPECT_EQ(read_lines(dir / "progress.after-checkpoint.csv").size(), 1u);
+  progress = read_lines(dir / "progress.csv");
   ASSERT_EQ(progress.size(), 5u);
   EXPECT_EQ(cells(progress[4])[0], "3");
   EXPECT_EQ(cells(progress[4])[1], "3000");
   EXPECT_GE(std::stol(cells(progress[4])[2]), episodes);
-  EXPECT_EQ(lines(dir / "test_returns.csv").size(), 1u + 4 * 4);
+  EXPECT_EQ(read_lines(dir / "test_returns.csv").size(), 1u + 4 * 4);
   train = 0;
   for (const nlohmann::json& j : jsonl(dir / "teacher.jsonl")) {
     if (j["kind"] == "train") {
@@ -156,7 +149,7 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
   std::vector<std::string> old_rows;
   {
     std::ostringstream text;
-    for (const std::string& line : lines(dir / "progress.csv")) {
+    for (const std::string& line : read_lines(dir / "progress.csv")) {
       std::string cut = line;
       for (int k = 0; k < 2; ++k) cut.erase(cut.rfind(','));
       old_rows.push_back(cut);
@@ -168,7 +161,7 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
   ASSERT_EQ(old_rows[0],
             "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
             "pct_mastered,mean_train_return");
-  std::vector<std::string> old_tests = lines(dir / "test_returns.csv");
+  std::vector<std::string> old_tests = read_lines(dir / "test_returns.csv");
   old_tests[0] = "evaluation,env_steps,task_index,return,solved";
   {
     std::ofstream out(dir / "test_returns.csv", std::ios::trunc);
@@ -185,7 +178,7 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
 
   // One CSV, one column count: the old rows under the current header with empty timing cells,
   // then the resumed run's row with its own.
-  const std::vector<std::string> progress = lines(dir / "progress.csv");
+  const std::vector<std::string> progress = read_lines(dir / "progress.csv");
   ASSERT_EQ(progress.size(), 5u);
   EXPECT_EQ(progress[0],
             "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
@@ -199,8 +192,8 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
   EXPECT_FALSE(cells(progress[4]).back().empty());  // teacher_s
 
   // A column that would be lost: the old file is kept whole beside a fresh one.
-  EXPECT_EQ(lines(dir / "test_returns.before-resume.csv"), old_tests);
-  const std::vector<std::string> tests = lines(dir / "test_returns.csv");
+  EXPECT_EQ(read_lines(dir / "test_returns.before-resume.csv"), old_tests);
+  const std::vector<std::string> tests = read_lines(dir / "test_returns.csv");
   ASSERT_EQ(tests.size(), 1u + 4);
   EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
   EXPECT_EQ(cells(tests[1])[0], "3");
@@ -209,18 +202,19 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
   r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_FALSE(fs::exists(dir / "progress.after-checkpoint.csv"));
-  EXPECT_EQ(lines(dir / "progress.csv"), progress);
+  EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
 }
 
 TEST(TmaRun, PpoStudentWithStudentReset) {
   const fs::path dir = fresh("cradle_tma_run_ppo");
-  const RunResult r = run_cradle(
-      "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.001 "
-      "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
-      "--hp batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --out " +
-      dir.string());
+  const std::string args =
+      "tma run --env stump-tracks --student ppo --teacher Random --test_every 500 "
+      "--nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 --hp "
+      "batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --out " +
+      dir.string();
+  const RunResult r = run_cradle(args + " --nb_env_steps 0.001");
   ASSERT_EQ(r.status, 0) << r.out;
-  const std::vector<std::string> progress = lines(dir / "progress.csv");
+  const std::vector<std::string> progress = read_lines(dir / "progress.csv");
   ASSERT_EQ(progress.size(), 4u);
   EXPECT_EQ(cells(progress[3])[1], "1000");
   const nlohmann::json state =
@@ -230,13 +224,9 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
   EXPECT_EQ(summary["env_steps"], 1000);
   // The preset's return statistics are in the checkpoint: the run resumes with them.
-  const RunResult resumed = run_cradle(
-      "tma run --env stump-tracks --student ppo --teacher Random --nb_env_steps 0.0015 "
-      "--test_every 500 --nb_test_episodes 4 --reset_frequency 500 --no-progress --hp n_steps=250 "
-      "--hp batch_size=50 --hp shared_layers=16 --hp pi_layers=16 --hp vf_layers= --resume --out " +
-      dir.string());
+  const RunResult resumed = run_cradle(args + " --nb_env_steps 0.0015 --resume");
   ASSERT_EQ(resumed.status, 0) << resumed.out;
-  EXPECT_EQ(lines(dir / "progress.csv").size(), 5u);
+  EXPECT_EQ(read_lines(dir / "progress.csv").size(), 5u);
 }
 
 TEST(TmaRun, BadInputIsAOneLineError) {
