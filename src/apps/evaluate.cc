@@ -57,7 +57,9 @@ void register_evaluate(CLI::App& app) {
                                      .render = opts->render,
                                      .seed = opts->seed,
                                      .video_extension = "." + opts->format,
-                                     .policy_actions = opts->stochastic ? "sampled" : "mean"};
+                                     .policy_actions = opts->policy.empty() ? "random"
+                                                       : opts->stochastic   ? "sampled"
+                                                                            : "mean"};
     const std::string behavior(behavior_name(config.behavior));
     const train::Policy policy =
         opts->policy.empty() ? nullptr : train::load_policy(config, opts->policy, opts->stochastic);
@@ -70,8 +72,8 @@ void register_evaluate(CLI::App& app) {
     }
     if (config.behavior != Behavior::kNone) {
       std::printf("evaluation (%s, %d episodes x %d steps, %s actions): %.4f +- %.4f\n",
-                  behavior.c_str(), opts->episodes, opts->duration,
-                  opts->policy.empty() ? "random" : options.policy_actions.c_str(), r.mean, r.std);
+                  behavior.c_str(), opts->episodes, opts->duration, options.policy_actions.c_str(),
+                  r.mean, r.std);
     }
     if (config.behavior == Behavior::kHandRegard) {
       double either = 0;

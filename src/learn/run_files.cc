@@ -154,6 +154,19 @@ long cut_training_log(const fs::path& log, long episodes) {
   return kept;
 }
 
+fs::path keep_aside_before_resume(const fs::path& file) {
+  const fs::path folder = file.parent_path();
+  const std::string stem = file.stem().string(), extension = file.extension().string();
+  fs::path kept = folder / (stem + ".before-resume" + extension);
+  for (int k = 2; fs::exists(kept); ++k) {
+    kept = folder / (stem + ".before-resume-" + std::to_string(k) + extension);
+  }
+  std::error_code ec;
+  fs::rename(file, kept, ec);
+  if (ec) throw UserError("cannot rename '" + file.string() + "': " + ec.message());
+  return kept;
+}
+
 ProgressCut cut_progress(const fs::path& csv, const std::string& header, long step) {
   ProgressCut result;
   std::error_code ec;
@@ -165,13 +178,7 @@ ProgressCut cut_progress(const fs::path& csv, const std::string& header, long st
 
   // Other columns (another version's file): kept whole beside the new one.
   if (lines.empty() || lines[0] != header + "\n") {
-    fs::path kept = folder / "progress.before-resume.csv";
-    for (int k = 2; fs::exists(kept); ++k) {
-      kept = folder / ("progress.before-resume-" + std::to_string(k) + ".csv");
-    }
-    fs::rename(csv, kept, ec);
-    if (ec) throw UserError("cannot rename '" + csv.string() + "': " + ec.message());
-    result.kept_aside = kept;
+    result.kept_aside = keep_aside_before_resume(csv);
     return result;
   }
 

@@ -37,6 +37,10 @@ RunState load_run_state(const std::filesystem::path& file, intrinsic::IntrinsicR
 // kept (fewer than `episodes` only if the log lost some).
 long cut_training_log(const std::filesystem::path& log, long episodes);
 
+// Renames a log written with other columns to <stem>.before-resume<ext> beside it (-2, -3, ...
+// after the stem when taken) and returns the new path; UserError when the rename fails.
+std::filesystem::path keep_aside_before_resume(const std::filesystem::path& file);
+
 // progress.csv on resume. When its header is `header`: rows up to `step` are kept, later rows and
 // a torn last line go to progress.after-checkpoint.csv beside it, and `append` is true. With
 // another header the file is renamed to progress.before-resume[-k].csv and `append` is false.

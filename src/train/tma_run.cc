@@ -134,15 +134,7 @@ bool adopt_header(const fs::path& file, const std::string& header) {
               << "current one (new columns empty)\n";
     return false;
   }
-  fs::path kept;
-  for (int k = 1; k == 1 || fs::exists(kept); ++k) {
-    kept =
-        file.parent_path() / (file.stem().string() + ".before-resume" +
-                              (k > 1 ? "-" + std::to_string(k) : "") + file.extension().string());
-  }
-  std::error_code ec;
-  fs::rename(file, kept, ec);
-  if (ec) throw UserError("cannot rename '" + file.string() + "': " + ec.message());
+  const fs::path kept = learn::keep_aside_before_resume(file);
   std::cerr << file.filename().string() << ": written with other columns, kept as " << kept.string()
             << "\n";
   return true;
