@@ -1,7 +1,5 @@
 #include "learn/run_files.h"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -50,22 +48,36 @@ std::vector<std::string_view> split_lines(std::string_view text, std::string_vie
   return lines;
 }
 
-// A staging folder beside `file`, removed when done; named by the process, because every rank of a
-// distributed run loads the same checkpoint at once.
+// A private staging folder in the system's temp folder (mkdtemp), removed when done. Not beside
+// the checkpoint: every rank of a distributed run loads the same checkpoint at once, and a process
+// killed mid-save would leave the folder among the user's checkpoints.
 struct Staging {
   fs::path dir;
-  explicit Staging(const fs::path& file)
-      : dir(fs::path(file) += ".intrinsic." + std::to_string(getpid())) {
+  explicit Staging(const fs::path& file) {
     std::error_code ec;
-    fs::remove_all(dir, ec);
-    fs::create_directories(dir, ec);
-    if (ec) throw UserError("cannot create " + dir.string() + ": " + ec.message());
+    std::string pattern = (fs::temp_directory_path(ec) / "cradle-intrinsic-XXXXXX").string();
+    if (ec || ::mkdtemp(pattern.data()) == nullptr) {
+      throw UserError("cannot create a staging folder for " + file.string() + " in " +
+                      fs::temp_directory_path(ec).string());
+    }
+    dir = pattern;
   }
   ~Staging() {
     std::error_code ec;
     fs::remove_all(dir, ec);
   }
 };
+
+// Builds before this one staged beside the checkpoint (`<file>.intrinsic.<pid>`); a process
+// killed mid-save left that folder behind. Nothing writes there now, so any such folder is stale.
+void remove_old_staging(const fs::path& file) {
+  std::error_code ec;
+  const std::string prefix = file.filename().string() + ".intrinsic.";
+  for (const auto& entry :
+       fs::directory_iterator(file.parent_path().empty() ? "." : file.parent_path(), ec)) {
+    if (entry.path().filename().string().starts_with(prefix)) fs::remove_all(entry.path(), ec);
+  }
+}
 
 }  // namespace
 
@@ -102,6 +114,7 @@ void save_run_checkpoint(const fs::path& file, const Learner& learner,
     }
   }
   write_sealed(file, sections);
+  remove_old_staging(file);
 }
 
 RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward) {

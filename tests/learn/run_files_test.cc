@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "learn/intrinsic/reward.h"
 #include "learn/learner.h"
 #include "learn/registry.h"
 #include "test_tasks.h"
@@ -81,6 +82,51 @@ TEST(RunFiles, ProgressCutToCheckpointStepRepairsTornLine) {
   EXPECT_TRUE(fs::exists(dir / "progress.before-resume.csv"));
   // No file: a new one.
   EXPECT_FALSE(cut_progress(csv, header, 256).append);
+}
+
+// A reward whose whole state is one number, saved as one file.
+class CounterReward final : public intrinsic::IntrinsicReward {
+ public:
+  CounterReward() : IntrinsicReward(1.0) {}
+  std::string_view name() const override { return "counter"; }
+  void compute(const VecEnv&, std::span<const double>, std::span<double>) override {}
+  void save(const fs::path& dir) const override {
+    std::ofstream(dir / "intrinsic_counter.txt") << count;
+  }
+  void load(const fs::path& dir) override {
+    std::ifstream in(dir / "intrinsic_counter.txt");
+    if (!(in >> count)) throw UserError("intrinsic_counter.txt missing");
+  }
+  long count = 0;
+};
+
+// The intrinsic state round-trips through the checkpoint, staged outside the checkpoint folder,
+// and a staging folder an older build left beside the checkpoint (killed mid-save) is swept away.
+TEST(RunFiles, IntrinsicStateRoundTripsAndLeavesNoStagingFolder) {
+  const fs::path dir = fresh_dir("staging");
+  const fs::path file = dir / "latest.ckpt";
+  fs::create_directories(dir / "latest.ckpt.intrinsic.4242");
+  write_text(dir / "latest.ckpt.intrinsic.4242" / "intrinsic_counter.txt", "7");
+  auto env = testing::make_cartpoles(1, 30);
+  auto learner = make_learner("ppo", *env, {});
+  CounterReward saved;
+  saved.count = 123456789;
+  save_run_checkpoint(file, *learner, &saved, {.steps = 64, .episodes = 2});
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  EXPECT_EQ(names, std::vector<std::string>{"latest.ckpt"});
+  CounterReward loaded;
+  const RunState state = load_run_state(file, &loaded);
+  EXPECT_EQ(loaded.count, 123456789);
+  EXPECT_EQ(state.steps, 64);
+  EXPECT_EQ(state.episodes, 2);
+  names.clear();
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  EXPECT_EQ(names, std::vector<std::string>{"latest.ckpt"});
 }
 
 TEST(RunFiles, NonFiniteLossIsOneLineErrorNamingTheUpdate) {
