@@ -36,12 +36,17 @@ void HandRegard::declare(Info& info) {
   }
   for (int eye = 0; eye < 2; ++eye) {
     either_slot_[eye] = info.declare(std::string(eyes[eye]) + "either_hand", InfoType::kInt);
+    angle_slot_[eye] = info.declare(std::string(eyes[eye]) + "gaze_angle", InfoType::kReal,
+                                    /*published=*/false);
   }
 }
 
-void HandRegard::reset(const mjModel*, const mjData*, Info& info) {
+void HandRegard::reset(const mjModel*, const mjData* d, Info& info) {
   for (int slot : pair_slot_) info.set(slot, 0);
   for (int slot : either_slot_) info.set(slot, 0);
+  for (int eye = 0; eye < 2; ++eye) {
+    info.set(angle_slot_[eye], std::min(gaze_angle(d, eye, 0), gaze_angle(d, eye, 1)));
+  }
 }
 
 double HandRegard::score(const Info& info, int steps) const {
@@ -110,14 +115,17 @@ bool HandRegard::visible(const mjModel* m, const mjData* d, int eye, int hand) c
 double HandRegard::after_step(const mjModel* m, const mjData* d, Info& info) {
   for (int eye = 0; eye < 2; ++eye) {
     bool either = false;
+    double nearest = 180;
     for (int hand = 0; hand < 2; ++hand) {
-      const double angle = gaze_angle(d, eye, hand) * std::numbers::pi / 180;
-      bool in_view = std::cos(angle) > cos_half_angle_;
+      const double degrees = gaze_angle(d, eye, hand);
+      nearest = std::min(nearest, degrees);
+      bool in_view = std::cos(degrees * std::numbers::pi / 180) > cos_half_angle_;
       if (in_view && occlusion_) in_view = visible(m, d, eye, hand);
       info.add(pair_slot_[2 * eye + hand], in_view);
       either = either || in_view;
     }
     info.add(either_slot_[eye], either);
+    info.set(angle_slot_[eye], nearest);
   }
   return 0;
 }

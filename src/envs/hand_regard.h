@@ -15,7 +15,9 @@ class HandRegard final : public Task {
   HandRegard(const mjModel* m, double half_angle_deg, bool occlusion);
   // Info: steps with each hand in view of each eye ("right_eye_right_hand", "right_eye_left_hand",
   // "left_eye_right_hand", "left_eye_left_hand") and, Cradle's extra, with either hand in view
-  // ("right_eye_either_hand", "left_eye_either_hand").
+  // ("right_eye_either_hand", "left_eye_either_hand"); unpublished, for learners only, each eye's
+  // angle (deg) to the nearer palm centre at this step ("right_eye_gaze_angle",
+  // "left_eye_gaze_angle").
   void declare(Info& info) override;
   void reset(const MimoCore& core, Info& info) override { reset(core.model(), core.data(), info); }
   double after_step(const MimoCore& core, Info& info) override {
@@ -48,6 +50,7 @@ class HandRegard final : public Task {
   std::array<int, 2> hand_body_{};
   std::array<int, 4> pair_slot_{};    // eye-major: right eye (right, left hand), left eye (...)
   std::array<int, 2> either_slot_{};  // right eye, left eye
+  std::array<int, 2> angle_slot_{};   // right eye, left eye
 };
 
 }  // namespace cradle::envs

@@ -20,6 +20,7 @@
 #include "learn/intrinsic/disagreement.h"
 #include "learn/intrinsic/episode_coverage.h"
 #include "learn/intrinsic/features.h"
+#include "learn/intrinsic/gaze_alignment.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
 #include "learn/intrinsic/regard_count.h"
@@ -710,6 +711,51 @@ TEST(RegardCount, EpisodeSumIsTheEitherHandCountOnTheRealEnv) {
   }
   EXPECT_EQ(episodes, 1);
   EXPECT_EQ(autoreset_reward, 0.0);  // the autoreset step is no transition
+
+  config.behavior = Behavior::kNone;
+  auto plain = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 2);
+  EXPECT_THROW(reward.bind(*plain), UserError);
+}
+
+// The gaze angles are the ones the counters threshold: an eye's either-hand counter grows at a
+// step exactly when its angle is inside the cone; the reward is the formula on those angles.
+TEST(GazeAlignment, AnglesAgreeWithTheCountersAndTheRewardIsTheFormula) {
+  Config config =
+      load_config(std::filesystem::path(CRADLE_SOURCE_DIR) / "configs/config_handregard.yml");
+  config.vision_active = false;
+  config.max_episode_steps = 200;
+  config.hand_regard_half_angle = 60;  // wide cones, so that some steps count and some do not
+  auto vec = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 2);
+  GazeAlignment reward(2.0);
+  reward.bind(*vec);
+  vec->reset(2);
+  const envs::Info& info = vec->info(0);
+  const int angle[2] = {info.find("right_eye_gaze_angle"), info.find("left_eye_gaze_angle")};
+  const int either[2] = {info.find("right_eye_either_hand"), info.find("left_eye_either_hand")};
+  EXPECT_EQ(info.to_json().count("right_eye_gaze_angle"), 0u);  // a learner's signal only
+  std::vector<double> actions(vec->action_space().size()), rewards(1);
+  double previous[2] = {0, 0};
+  int inside = 0, outside = 0;
+  for (int t = 0; t < 150; ++t) {
+    for (size_t k = 0; k < actions.size(); ++k) actions[k] = std::sin(0.05 * t + 0.7 * k);
+    vec->step(actions);
+    rewards[0] = 0.25;
+    reward.compute(*vec, actions, rewards);
+    double expected = 0;
+    for (int eye = 0; eye < 2; ++eye) {
+      const double theta = info.number(angle[eye]);
+      ASSERT_GE(theta, 0);
+      ASSERT_LE(theta, 180);
+      const bool counted = info.number(either[eye]) > previous[eye];
+      EXPECT_EQ(counted, theta < 60) << "step " << t << " eye " << eye << " angle " << theta;
+      (counted ? inside : outside) += 1;
+      previous[eye] = info.number(either[eye]);
+      expected += (1 - theta / 180) * (1 - theta / 180);
+    }
+    EXPECT_NEAR(rewards[0], 0.25 + 2.0 * expected / 2, 1e-12);
+  }
+  EXPECT_GT(inside, 0);
+  EXPECT_GT(outside, 0);
 
   config.behavior = Behavior::kNone;
   auto plain = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 2);

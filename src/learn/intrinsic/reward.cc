@@ -10,6 +10,7 @@
 #include "learn/intrinsic/body_part_novelty.h"
 #include "learn/intrinsic/disagreement.h"
 #include "learn/intrinsic/episode_coverage.h"
+#include "learn/intrinsic/gaze_alignment.h"
 #include "learn/intrinsic/hand_visibility.h"
 #include "learn/intrinsic/icm.h"
 #include "learn/intrinsic/regard_count.h"
@@ -36,6 +37,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"episode_coverage", factory<EpisodeCoverage>()},
       {"hand_visibility", factory<HandVisibility>()},
       {"regard_count", factory<RegardCount>()},
+      {"gaze_alignment", factory<GazeAlignment>()},
       {"rnd", factory<Rnd>()},
       {"icm", factory<Icm>()},
       {"disagreement", factory<Disagreement>()},
