@@ -104,7 +104,9 @@ void save_run_checkpoint(const fs::path& file, const Learner& learner,
                                          : message.substr(at)));
   }
   Sections sections = read_sealed(part, "checkpoint");
-  sections[kRunSection] = nlohmann::json{{"steps", run.steps}, {"episodes", run.episodes}}.dump();
+  nlohmann::json state{{"steps", run.steps}, {"episodes", run.episodes}};
+  if (run.intrinsic) state["intrinsic"] = *run.intrinsic;
+  sections[kRunSection] = state.dump();
   if (reward) {
     const Staging staging(file);
     reward->save(staging.dir);
@@ -131,6 +133,11 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
   }
   state.steps = j["steps"].get<long>();
   state.episodes = j["episodes"].get<long>();
+  if (j.contains("intrinsic")) {
+    if (!j["intrinsic"].is_string())
+      throw UserError(file.string() + ": checkpoint run state is malformed");
+    state.intrinsic = j["intrinsic"].get<std::string>();
+  }
   if (reward) {
     const Staging staging(file);
     for (const auto& [name, bytes] : sections) {
@@ -141,7 +148,12 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
       }
       std::ofstream(staging.dir / base, std::ios::binary) << bytes;
     }
-    reward->load(staging.dir);
+    try {
+      reward->load(staging.dir);
+    } catch (const UserError& e) {
+      throw UserError(file.string() + ": no matching intrinsic-reward state (" + e.what() +
+                      "); was it trained with another --intrinsic?");
+    }
   }
   return state;
 }

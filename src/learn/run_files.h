@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,9 @@ class IntrinsicReward;
 struct RunState {
   long steps = 0;     // env steps (the learner's counter)
   long episodes = 0;  // entries of logs/training.jsonl at the checkpoint (after flushing it)
+  // The run's intrinsic rewards as Composite::describe() writes them ("" none); absent in
+  // checkpoints of earlier builds.
+  std::optional<std::string> intrinsic;
 };
 
 // Writes `file`: the learner's checkpoint with sections "run" (RunState as JSON) and

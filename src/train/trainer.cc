@@ -174,6 +174,14 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     hyperparameters = parse_hyperparameter_text(info.config);
     for (const auto& [name, value] : options.hyperparameters) hyperparameters[name] = value;
     resumed = load_run_state(latest, nullptr);
+    // The rewards are part of the task being learned: a resumed run keeps them.
+    const std::string wanted =
+        options.intrinsic.empty() ? "" : intrinsic::parse_intrinsic(options.intrinsic)->describe();
+    if (resumed.intrinsic && *resumed.intrinsic != wanted) {
+      throw UserError("--resume: the checkpoint was trained with --intrinsic '" +
+                      *resumed.intrinsic + "', not '" + wanted + "' (give --intrinsic '" +
+                      *resumed.intrinsic + "' to continue it)");
+    }
   }
   // Data-parallel: rank r seeds with seed + r; ranks above 0 log their envs in a folder of their
   // own (continued as they are on resume: the checkpoint counts rank 0's episodes).
@@ -303,7 +311,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     training.end_episodes();
     if (training_log) training_log->flush();
     const RunState run{.steps = learner->steps(),
-                       .episodes = training_log ? training_log->episodes() : 0};
+                       .episodes = training_log ? training_log->episodes() : 0,
+                       .intrinsic = reward ? reward->describe() : ""};
     if (rank > 0) return;  // rank 0 writes the run's checkpoints
     for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
   };

@@ -241,4 +241,23 @@ TEST(Resume, ContradictingAlgoIsRefused) {
   fs::remove_all(dir);
 }
 
+// The intrinsic rewards are part of the learned task: a resume under other rewards is one line
+// naming both, the same rewards continue.
+TEST(Resume, ContradictingIntrinsicIsRefused) {
+  const fs::path dir = temp_dir("intrinsic");
+  CliRun r = cradle(train_args(dir) + " --steps 128");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::string other = train_args(dir);
+  other.replace(other.find("--intrinsic body_part_novelty"), 29, "--intrinsic touch_count:2");
+  r = cradle(other + " --steps 256 --resume");
+  EXPECT_EQ(r.status, 1) << r.out;
+  const std::vector<std::string> lines = message_lines(r.out);
+  ASSERT_EQ(lines.size(), 1u) << r.out;
+  EXPECT_NE(lines[0].find("'body_part_novelty:1'"), std::string::npos) << r.out;
+  EXPECT_NE(lines[0].find("'touch_count:2'"), std::string::npos) << r.out;
+  r = cradle(train_args(dir) + " --steps 256 --resume");
+  EXPECT_EQ(r.status, 0) << r.out;
+  fs::remove_all(dir);
+}
+
 }  // namespace

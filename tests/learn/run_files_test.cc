@@ -111,7 +111,8 @@ TEST(RunFiles, IntrinsicStateRoundTripsAndLeavesNoStagingFolder) {
   auto learner = make_learner("ppo", *env, {});
   CounterReward saved;
   saved.count = 123456789;
-  save_run_checkpoint(file, *learner, &saved, {.steps = 64, .episodes = 2});
+  save_run_checkpoint(file, *learner, &saved,
+                      {.steps = 64, .episodes = 2, .intrinsic = "counter:1"});
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
     names.push_back(entry.path().filename().string());
@@ -122,6 +123,7 @@ TEST(RunFiles, IntrinsicStateRoundTripsAndLeavesNoStagingFolder) {
   EXPECT_EQ(loaded.count, 123456789);
   EXPECT_EQ(state.steps, 64);
   EXPECT_EQ(state.episodes, 2);
+  EXPECT_EQ(state.intrinsic, std::optional<std::string>("counter:1"));
   names.clear();
   for (const auto& entry : fs::directory_iterator(dir)) {
     names.push_back(entry.path().filename().string());
