@@ -223,21 +223,36 @@ void motor(Agent& agent, b2RevoluteJoint* joint, double speed, const b2Body* con
                                .contact = contact ? tag_of(contact) : nullptr});
 }
 
-b2Body* chimpanzee_trunk(Agent& agent, b2World& world, double x0, double y0, const Fixture& fixture,
-                         Rgb c1, Rgb c2) {
-  const auto at = [](double x, double y) {
-    return b2Vec2(static_cast<float>(x), static_cast<float>(y));
-  };
+Chimpanzee chimpanzee(Agent& agent, b2World& world, double x0, double y0, bool legs,
+                      bool critical_feet) {
+  constexpr double kPi = std::numbers::pi;
+  const Rgb hull1{0.5f, 0.4f, 0.9f}, hull2{0.3f, 0.3f, 0.5f};
+  const Rgb leg1{0.5f, 0.2f, 0.4f}, leg2{0.3f, 0.1f, 0.2f};
+  agent.torque = 100;
+  agent.torque_penalty = 3.5e-4 / 5;
+  agent.remove_head_angle = true;
+  Chimpanzee c;
+  // Head and torso collide with terrain only, like the limbs.
+  const Fixture body_fd{.density = 5.0, .friction = 0.1, .mask = 0x1};
   const b2PolygonShape head_shape = pixel_polygon({{-5, 10}, {5, 10}, {5, -10}, {-5, -10}});
   b2Body* head = part(agent, world, at(x0, y0 + 45 / kScale / 2 + 20 / kScale / 2 + 0.2), 0,
-                      head_shape, fixture, true, true, c1, c2);
+                      head_shape, body_fd, true, true, hull1, hull2);
   agent.head = head;
   agent.pushed.push_back(head);
   const b2PolygonShape torso_shape = pixel_polygon({{-12, 25}, {12, 25}, {8, -20}, {-8, -20}});
-  b2Body* torso = part(agent, world, at(x0, y0), 0, torso_shape, fixture, true, true, c1, c2);
-  joint(world, head, torso, at(x0, y0 + 45 / kScale / 2), -0.1 * std::numbers::pi,
-        0.1 * std::numbers::pi, false);
-  return torso;
+  c.torso = part(agent, world, at(x0, y0), 0, torso_shape, body_fd, true, true, hull1, hull2);
+  joint(world, head, c.torso, at(x0, y0 + 45 / kScale / 2), -0.1 * kPi, 0.1 * kPi, false);
+  const double down = Chimpanzee::kLegDown, h = Chimpanzee::kLimbH;
+  for (int k = 0; legs && k < 2; ++k) {
+    b2Body* upper = part(agent, world, at(x0, y0 - h / 2 - down), 0, c.upper, c.limb_fd, false,
+                         false, leg1, leg2);
+    motor(agent, joint(world, c.torso, upper, at(x0, y0 - down), -0.3 * kPi, 0.6 * kPi, true), 4);
+    b2Body* lower = part(agent, world, at(x0, y0 - h * 1.5 - down), 0, c.lower, c.limb_fd, true,
+                         critical_feet, leg1, leg2);
+    motor(agent, joint(world, upper, lower, at(x0, y0 - h - down), -0.75 * kPi, -0.1, true), 6,
+          lower, 1.0);
+  }
+  return c;
 }
 
 }  // namespace build

@@ -10,7 +10,6 @@ namespace cradle::tma {
 void build_fish(Agent& agent, b2World& world, double x0, double y0) {
   using build::Fixture;
   constexpr double kPi = std::numbers::pi;
-  auto at = [](double x, double y) { return b2Vec2(static_cast<float>(x), static_cast<float>(y)); };
   agent.torque = 80;
   agent.torque_penalty = 3.5e-4;
   agent.remove_head_angle = true;
