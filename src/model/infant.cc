@@ -195,14 +195,20 @@ void add_leg(Infant& infant, Side side, const LegMasses& m) {
   infant.bodies.push_back(lower);
 }
 
-std::vector<Joint> ankle_joints(Side side) {
+void add_foot_body(Infant& infant, Side side, std::vector<Geom> geoms) {
   const double s = side == Side::kRight ? 1 : -1;
   const std::string p = side_prefix(side);
-  return {
+  Body foot{.name = p + "foot", .parent = p + "lower_leg", .pos = {0, 0, -.177}};
+  foot.geoms = std::move(geoms);
+  foot.geoms[1].friction = kSoleGrip;
+  foot.geoms[2].friction = kSoleGrip;
+  foot.joints = {
       hinge(p + "foot1", {0, -1, 0}, {0, 0, .015}, -63, 32, -10, 1.29, 0.6, .019, .003),
       hinge(p + "foot2", {s, 0, 0}, {0, 0, .015}, -33, 31, 0, 0.96, 0.37, .011, .0025),
       hinge(p + "foot3", {0, 0, s}, {0, 0, .015}, -20, 30, 0, 1.15, 0.38, .012, .002),
   };
+  foot.sites.push_back({.name = "torque_" + p + "ankle"});
+  infant.bodies.push_back(foot);
 }
 
 namespace {

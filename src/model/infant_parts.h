@@ -38,8 +38,12 @@ void add_trunk_and_head(Infant& infant, const TrunkMasses& masses);
 void add_arm(Infant& infant, Side side, double upper_mass, double lower_mass);
 // Upper and lower leg of one side.
 void add_leg(Infant& infant, Side side, const LegMasses& masses);
-// The three ankle hinges of one foot.
-std::vector<Joint> ankle_joints(Side side);
+// Soles and toes grip twice as hard as skin (sliding, torsional, rolling friction).
+inline constexpr Vec3 kSoleGrip{2, 0.02, 0.01};
+// The foot body of one side below its lower leg, `geoms` being its heel cylinder, sole box and
+// ball cylinder (the last two gripping with kSoleGrip), with the three ankle hinges and their
+// torque site.
+void add_foot_body(Infant& infant, Side side, std::vector<Geom> geoms);
 
 // Actuators common to both versions, appended in BabyBench group order.
 void add_body_head_eye_actuators(Infant& infant);

@@ -39,28 +39,22 @@ void add_mitten(Infant& infant, Side side) {
   infant.bodies.push_back(fingers);
 }
 
-// Foot body and one toes body; soles and toes grip twice as hard as skin.
+// Foot body and one toes body.
 void add_foot(Infant& infant, Side side) {
   const std::string p = side_prefix(side);
-  const Vec3 grip{2, 0.02, 0.01};
-  Body foot{.name = p + "foot", .parent = p + "lower_leg", .pos = {0, 0, -.177}};
-  foot.geoms = {
-      cylinder("", {.0249, .0099}, {-0.016, 0, 0}, {0, 0, 0}, .03219, "sock"),
-      box("", {.035, .025, .01}, {0.019, 0, 0}, {0, 0, 0}, .05850, "sock"),
-      cylinder("", {.0099, .0248}, {.054, 0, 0}, {90, 0, 0}, .01268, "sock"),
-  };
-  foot.geoms[1].friction = grip;
-  foot.geoms[2].friction = grip;
-  foot.joints = ankle_joints(side);
-  foot.sites.push_back({.name = "torque_" + p + "ankle"});
-  infant.bodies.push_back(foot);
+  add_foot_body(infant, side,
+                {
+                    cylinder("", {.0249, .0099}, {-0.016, 0, 0}, {0, 0, 0}, .03219, "sock"),
+                    box("", {.035, .025, .01}, {0.019, 0, 0}, {0, 0, 0}, .05850, "sock"),
+                    cylinder("", {.0099, .0248}, {.054, 0, 0}, {90, 0, 0}, .01268, "sock"),
+                });
 
   Body toes{.name = p + "toes", .parent = p + "foot", .pos = {.054, 0, 0}};
   toes.geoms = {
       box("", {.007, .0249, .0099}, {.007, 0, 0}, {0, 0, 0}, .01084, "sock"),
       cylinder("", {.01, .025}, {.014, 0, 0}, {90, 0, 0}, .01226, "sock"),
   };
-  for (Geom& g : toes.geoms) g.friction = grip;
+  for (Geom& g : toes.geoms) g.friction = kSoleGrip;
   toes.joints.push_back(
       hinge(p + "toes", {0, -1, 0}, {0, 0, 0}, -60, 80, 0, .106, .04, .005, .0005));
   toes.sites.push_back({.name = "torque_" + p + "toes"});

@@ -206,23 +206,17 @@ void add_hand(Infant& infant, Side side) {
   add_thumb(infant, side);
 }
 
-// Foot with a big-toe and a toes body; soles and toes grip twice as hard as skin. The reference
-// lists big_toe first on the right foot and toes first on the left.
+// Foot with a big-toe and a toes body. The reference lists big_toe first on the right foot and
+// toes first on the left.
 void add_foot(Infant& infant, Side side) {
   const double s = side == Side::kRight ? 1 : -1;
   const std::string p = side_prefix(side);
-  const Vec3 grip{2, 0.02, 0.01};
-  Body foot = make_body(p + "foot", p + "lower_leg", {0, 0, -.177});
-  foot.geoms = {
-      cylinder("", {.0249, .0101}, {-0.007, 0, 0}, {0, 0, 0}, .03225, "sock"),
-      box("", {.030, .025, .01}, {0.023, 0, 0}, {0, 0, 0}, .04923, "sock"),
-      cylinder("", {.0101, .0251}, {.053, 0, 0}, {90, 0, 0}, .01312, "sock"),
-  };
-  foot.geoms[1].friction = grip;
-  foot.geoms[2].friction = grip;
-  foot.joints = ankle_joints(side);
-  foot.sites.push_back({.name = "torque_" + p + "ankle"});
-  infant.bodies.push_back(foot);
+  add_foot_body(infant, side,
+                {
+                    cylinder("", {.0249, .0101}, {-0.007, 0, 0}, {0, 0, 0}, .03225, "sock"),
+                    box("", {.030, .025, .01}, {0.023, 0, 0}, {0, 0, 0}, .04923, "sock"),
+                    cylinder("", {.0101, .0251}, {.053, 0, 0}, {90, 0, 0}, .01312, "sock"),
+                });
 
   // A toe body: a box and a rounded tip across the foot; the big toe is medial (+y on the right).
   auto toe = [&](const std::string& name, double y, double box_half_width, double box_mass,
@@ -232,7 +226,7 @@ void add_foot(Infant& infant, Side side) {
         box("", {.0095, box_half_width, .0099}, {.0095, 0, 0}, {0, 0, 0}, box_mass, "sock"),
         cylinder("", {.01, tip_half_length}, {.019, 0, 0}, {90, 0, 0}, tip_mass, "sock"),
     };
-    for (Geom& g : b.geoms) g.friction = grip;
+    for (Geom& g : b.geoms) g.friction = kSoleGrip;
     b.joints.push_back(hinge(p + name, {0, -1, 0}, {0, 0, 0}, -60, 80, 0, .053, .02, .002, .0001));
     b.sites.push_back({.name = "torque_" + p + name});
     return b;
