@@ -59,24 +59,44 @@ double Agent::mass() const {
   return m;
 }
 
-// The table of embodiments: sizes the environments need before building one.
+// The table of embodiments: sizes the environments need before building one, and the builder
+// (the bodies that are never critical, and the climbers, adapted to the one signature).
 const std::vector<Embodiment>& embodiments() {
   static const std::vector<Embodiment> table = {
-      {"old_classic_bipedal", BodyKind::kWalker, 64 / kScale, 2.5, true, 34 / kScale, 0},
-      {"small_bipedal", BodyKind::kWalker, 20 / kScale, 37 / kScale, false, 17 / kScale, 0},
-      {"old_big_quadru", BodyKind::kWalker, 96 / kScale, (102 - 8) / kScale, true, 51 / kScale, 0},
-      {"spider", BodyKind::kWalker, 100 / kScale, 24 / kScale, false, 20 / kScale, 0},
-      {"millipede", BodyKind::kWalker, 80 / kScale, 23 / kScale, false, 10 / kScale, 0},
-      {"profile_chimpanzee", BodyKind::kWalker, 24 / kScale, 68 / kScale, false, 28 / kScale, 0},
+      {"old_classic_bipedal", BodyKind::kWalker, 64 / kScale, 2.5, true, 34 / kScale, 0,
+       build_old_classic_bipedal},
+      {"small_bipedal", BodyKind::kWalker, 20 / kScale, 37 / kScale, false, 17 / kScale, 0,
+       build_small_bipedal},
+      {"old_big_quadru", BodyKind::kWalker, 96 / kScale, (102 - 8) / kScale, true, 51 / kScale, 0,
+       build_old_big_quadru},
+      {"spider", BodyKind::kWalker, 100 / kScale, 24 / kScale, false, 20 / kScale, 0, build_spider},
+      {"millipede", BodyKind::kWalker, 80 / kScale, 23 / kScale, false, 10 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) { build_millipede(a, w, x, y); }},
+      {"profile_chimpanzee", BodyKind::kWalker, 24 / kScale, 68 / kScale, false, 28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_profile_chimpanzee(a, w, x, y);
+       }},
       {"climbing_profile_chimpanzee", BodyKind::kClimber, 24 / kScale, 68 / kScale, false,
-       28 / kScale, 0},
+       28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_climbing_chimpanzee(a, w, x, y, /*legs=*/true);
+       }},
       {"climbing_chest_profile_chimpanzee", BodyKind::kClimber, 24 / kScale, 68 / kScale, false,
-       28 / kScale, 0},
-      {"fish", BodyKind::kSwimmer, 35 / kScale, 9 / kScale, false, 0, 1.0},
-      {"amphibious_bipedal", BodyKind::kAmphibian, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
-      {"classic_bipedal", BodyKind::kWalker, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
-      {"big_quadru", BodyKind::kWalker, 96 / kScale, 105 / kScale, false, 51 / kScale, 0},
-      {"wheel", BodyKind::kWalker, 20 / kScale, 30 / kScale, false, 10 / kScale, 0},
+       28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_climbing_chimpanzee(a, w, x, y, /*legs=*/false);
+       }},
+      {"fish", BodyKind::kSwimmer, 35 / kScale, 9 / kScale, false, 0, 1.0,
+       [](Agent& a, b2World& w, double x, double y, bool) { build_fish(a, w, x, y); }},
+      {"amphibious_bipedal", BodyKind::kAmphibian, 64 / kScale, 71 / kScale, false, 34 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_amphibious_bipedal(a, w, x, y);
+       }},
+      {"classic_bipedal", BodyKind::kWalker, 64 / kScale, 71 / kScale, false, 34 / kScale, 0,
+       build_classic_bipedal},
+      {"big_quadru", BodyKind::kWalker, 96 / kScale, 105 / kScale, false, 51 / kScale, 0,
+       build_big_quadru},
+      {"wheel", BodyKind::kWalker, 20 / kScale, 30 / kScale, false, 10 / kScale, 0, build_wheel},
   };
   return table;
 }
@@ -106,33 +126,7 @@ void build_agent(std::string_view name, b2World& world, double x0, double y0, do
   agent = Agent{};
   agent.kind = e.kind;
   const double y = y0 + e.spawn_dy;
-  if (name == "old_classic_bipedal") {
-    build_old_classic_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "classic_bipedal") {
-    build_classic_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "small_bipedal") {
-    build_small_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "amphibious_bipedal") {
-    build_amphibious_bipedal(agent, world, x0, y);
-  } else if (name == "old_big_quadru") {
-    build_old_big_quadru(agent, world, x0, y, stump_tracks);
-  } else if (name == "big_quadru") {
-    build_big_quadru(agent, world, x0, y, stump_tracks);
-  } else if (name == "wheel") {
-    build_wheel(agent, world, x0, y, stump_tracks);
-  } else if (name == "spider") {
-    build_spider(agent, world, x0, y, stump_tracks);
-  } else if (name == "millipede") {
-    build_millipede(agent, world, x0, y);
-  } else if (name == "profile_chimpanzee") {
-    build_profile_chimpanzee(agent, world, x0, y);
-  } else if (name == "climbing_profile_chimpanzee") {
-    build_climbing_chimpanzee(agent, world, x0, y, /*legs=*/true);
-  } else if (name == "climbing_chest_profile_chimpanzee") {
-    build_climbing_chimpanzee(agent, world, x0, y, /*legs=*/false);
-  } else if (name == "fish") {
-    build_fish(agent, world, x0, y);
-  }
+  e.build(agent, world, x0, y, stump_tracks);
   // The initial push acts during the first world step only (Box2D clears forces after a step).
   for (b2Body* b : agent.pushed) b->ApplyForceToCenter(b2Vec2(static_cast<float>(force), 0), true);
 }

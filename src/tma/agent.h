@@ -53,7 +53,11 @@ struct Agent {
   double mass() const;  // every part and sensor
 };
 
-// What the environments need to place an embodiment before building it.
+// Builds an embodiment's parts with its origin at (x0, y0); `stump_tracks` makes walker hulls
+// critical.
+using Builder = void (*)(Agent&, b2World&, double x0, double y0, bool stump_tracks);
+
+// What the environments need to place an embodiment before building it, and its builder.
 struct Embodiment {
   std::string name;
   BodyKind kind;
@@ -62,6 +66,7 @@ struct Embodiment {
   bool old_morphology;   // spawned at TERRAIN_HEIGHT + 2 * leg_h in Stump Tracks
   double leg_h;
   double spawn_dy;  // added to the spawn height by the body itself (fish: +1)
+  Builder build;
 };
 
 // Every embodiment's name, in the seed's order first.
