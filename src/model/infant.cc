@@ -296,12 +296,21 @@ void add_ankle_actuators(Infant& infant, Side side) {
       motor(p + "foot_rotation", p + "foot3", Group::kFeet, 1.2, -1, 1, {2.688, 3.868, 3.625}));
 }
 
-void add_head_and_trunk_sensors(Infant& infant) {
+void add_torque_sensors(Infant& infant, const std::vector<std::string>& arm_joints,
+                        const std::vector<std::string>& leg_joints) {
   infant.torque_sensors.insert(infant.torque_sensors.end(), {{"neck", "torque_neck"},
                                                              {"left_eye", "torque_left_eye"},
                                                              {"right_eye", "torque_right_eye"},
                                                              {"trunk_upper", "torque_ub"},
                                                              {"trunk_lower", "torque_lb"}});
+  for (const std::vector<std::string>* joints : {&arm_joints, &leg_joints}) {
+    for (Side side : {Side::kRight, Side::kLeft}) {
+      const std::string p = side_prefix(side);
+      for (const std::string& joint : *joints) {
+        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
+      }
+    }
+  }
 }
 
 void add_tendons_and_contacts(Infant& infant) {

@@ -52,8 +52,11 @@ void add_hand_actuators(Infant& infant);
 void add_leg_actuators(Infant& infant);
 void add_ankle_actuators(Infant& infant, Side side);
 
-// Torque sensors of the head, eyes and trunk (the first five of the reference order).
-void add_head_and_trunk_sensors(Infant& infant);
+// Every torque sensor in the reference's sensordata order: head, eyes and trunk, then the arms'
+// and then the legs' joints, right side before left, each side's in the order of `arm_joints` /
+// `leg_joints` (sites "torque_<side>_<joint>").
+void add_torque_sensors(Infant& infant, const std::vector<std::string>& arm_joints,
+                        const std::vector<std::string>& leg_joints);
 // Trunk-coupling and head-limit tendons, the hip/torso contact pair and eye exclusions.
 void add_tendons_and_contacts(Infant& infant);
 

@@ -1,6 +1,5 @@
 // MIMo v1: mitten hands (one palm body and one "fingers" body per hand) and one toes body per
 // foot. Numbers are the reference model's (mimo_core.md §1.2-1.3, §1.6, §2.1).
-#include <array>
 #include <string>
 
 #include "model/infant.h"
@@ -105,17 +104,8 @@ Infant make_mimo_v1() {
                                 .user = {1.290, 2.947, .8440}});
   }
 
-  // Torque sensors in the reference's sensordata order.
-  add_head_and_trunk_sensors(infant);
-  for (const auto& joints : {std::array<const char*, 4>{"shoulder", "elbow", "wrist", "fingers"},
-                             std::array<const char*, 4>{"hip", "knee", "ankle", "toes"}}) {
-    for (Side side : {Side::kRight, Side::kLeft}) {
-      const std::string p = side_prefix(side);
-      for (const char* joint : joints) {
-        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
-      }
-    }
-  }
+  add_torque_sensors(infant, {"shoulder", "elbow", "wrist", "fingers"},
+                     {"hip", "knee", "ankle", "toes"});
 
   add_tendons_and_contacts(infant);
   return infant;

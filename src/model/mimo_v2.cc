@@ -344,22 +344,10 @@ Infant make_mimo_v2() {
   infant.actuators.push_back(toe_motor("left_toes", 1.774));
   infant.actuators.push_back(toe_motor("left_big_toe", 1.805));
 
-  // Torque sensors in the reference's sensordata order.
-  add_head_and_trunk_sensors(infant);
-  const std::vector<std::string> arm_sensors = [] {
-    std::vector<std::string> names = {"shoulder", "elbow", "wrist"};
-    names.insert(names.end(), kFingerSensors.begin(), kFingerSensors.end());
-    return names;
-  }();
-  const std::vector<std::string> leg_sensors = {"hip", "knee", "ankle", "toes", "big_toe"};
-  for (const std::vector<std::string>* joints : {&arm_sensors, &leg_sensors}) {
-    for (Side side : {Side::kRight, Side::kLeft}) {
-      const std::string p = side_prefix(side);
-      for (const std::string& joint : *joints) {
-        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
-      }
-    }
-  }
+  // Torque sensors: the arms' fingers after the wrist, the big toe after the toes.
+  std::vector<std::string> arm_sensors = {"shoulder", "elbow", "wrist"};
+  arm_sensors.insert(arm_sensors.end(), kFingerSensors.begin(), kFingerSensors.end());
+  add_torque_sensors(infant, arm_sensors, {"hip", "knee", "ankle", "toes", "big_toe"});
 
   add_tendons_and_contacts(infant);
   return infant;
