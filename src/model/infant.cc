@@ -223,7 +223,6 @@ Actuator motor(std::string name, std::string joint, Group group, double gear, do
           .force_hi = hi,
           .user = user};
 }
-}  // namespace
 
 void add_body_head_eye_actuators(Infant& infant) {
   auto& a = infant.actuators;
@@ -294,6 +293,21 @@ void add_ankle_actuators(Infant& infant, Side side) {
       motor(p + "foot_inversion", p + "foot2", Group::kFeet, 1.16, -.91, 1, {1.988, 4.184, 4.645}));
   a.push_back(
       motor(p + "foot_rotation", p + "foot3", Group::kFeet, 1.2, -1, 1, {2.688, 3.868, 3.625}));
+}
+
+}  // namespace
+
+void add_actuators(Infant& infant, const std::function<void(Side)>& add_fingers,
+                   const std::function<void(Side)>& add_toes) {
+  add_body_head_eye_actuators(infant);
+  add_arm_actuators(infant);
+  add_hand_actuators(infant);
+  for (Side side : {Side::kRight, Side::kLeft}) add_fingers(side);
+  add_leg_actuators(infant);
+  for (Side side : {Side::kRight, Side::kLeft}) {
+    add_ankle_actuators(infant, side);
+    add_toes(side);
+  }
 }
 
 void add_torque_sensors(Infant& infant, const std::vector<std::string>& arm_joints,

@@ -1,6 +1,7 @@
 // Building blocks shared by the v1 and v2 tables (internal to src/model).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -45,12 +46,11 @@ inline constexpr Vec3 kSoleGrip{2, 0.02, 0.01};
 // torque site.
 void add_foot_body(Infant& infant, Side side, std::vector<Geom> geoms);
 
-// Actuators common to both versions, appended in BabyBench group order.
-void add_body_head_eye_actuators(Infant& infant);
-void add_arm_actuators(Infant& infant);
-void add_hand_actuators(Infant& infant);
-void add_leg_actuators(Infant& infant);
-void add_ankle_actuators(Infant& infant, Side side);
+// Every actuator in BabyBench group order: body, head, eyes, arms, hands, the fingers of each side
+// (`add_fingers`, the version's), legs, then each side's ankle followed by its toes (`add_toes`,
+// the version's); right side before left.
+void add_actuators(Infant& infant, const std::function<void(Side)>& add_fingers,
+                   const std::function<void(Side)>& add_toes);
 
 // Every torque sensor in the reference's sensordata order: head, eyes and trunk, then the arms'
 // and then the legs' joints, right side before left, each side's in the order of `arm_joints` /

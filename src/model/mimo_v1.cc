@@ -77,32 +77,29 @@ Infant make_mimo_v1() {
     add_foot(infant, side);
   }
 
-  // Actuators in BabyBench group order: body, head, eyes, arms, hands, fingers, legs, feet.
-  add_body_head_eye_actuators(infant);
-  add_arm_actuators(infant);
-  add_hand_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    const std::string p = side_prefix(side);
-    infant.actuators.push_back({.name = p + "fingers",
-                                .joint = p + "fingers",
-                                .group = Group::kFingers,
-                                .gear = .69,
-                                .force_lo = -1,
-                                .force_hi = .33,
-                                .user = {3.019, 6.854, 2.551}});
-  }
-  add_leg_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    add_ankle_actuators(infant, side);
-    const std::string p = side_prefix(side);
-    infant.actuators.push_back({.name = p + "toes",
-                                .joint = p + "toes",
-                                .group = Group::kFeet,
-                                .gear = .33,
-                                .force_lo = -1,
-                                .force_hi = .3,
-                                .user = {1.290, 2.947, .8440}});
-  }
+  // Actuators: one mitten motor per hand, one toes motor per foot.
+  add_actuators(
+      infant,
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        infant.actuators.push_back({.name = p + "fingers",
+                                    .joint = p + "fingers",
+                                    .group = Group::kFingers,
+                                    .gear = .69,
+                                    .force_lo = -1,
+                                    .force_hi = .33,
+                                    .user = {3.019, 6.854, 2.551}});
+      },
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        infant.actuators.push_back({.name = p + "toes",
+                                    .joint = p + "toes",
+                                    .group = Group::kFeet,
+                                    .gear = .33,
+                                    .force_lo = -1,
+                                    .force_hi = .3,
+                                    .user = {1.290, 2.947, .8440}});
+      });
 
   add_torque_sensors(infant, {"shoulder", "elbow", "wrist", "fingers"},
                      {"hip", "knee", "ankle", "toes"});

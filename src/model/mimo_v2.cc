@@ -319,30 +319,27 @@ Infant make_mimo_v2() {
     add_foot(infant, side);
   }
 
-  // Actuators in BabyBench group order: body, head, eyes, arms, hands, fingers, legs, feet.
-  add_body_head_eye_actuators(infant);
-  add_arm_actuators(infant);
-  add_hand_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    const std::string p = side_prefix(side);
-    for (const FingerMotor& m : kFingerMotors) {
-      infant.actuators.push_back({.name = p + m.actuator,
-                                  .joint = p + m.joint,
-                                  .group = Group::kFingers,
-                                  .gear = m.gear,
-                                  .force_lo = m.lo,
-                                  .force_hi = m.hi,
-                                  .user = m.user});
-    }
-  }
-  add_leg_actuators(infant);
-  // Upstream v2 toe rows (BabyBench's kit swaps in v1's numbers); the left foot lists toes first.
-  add_ankle_actuators(infant, Side::kRight);
-  infant.actuators.push_back(toe_motor("right_big_toe", 1.774));
-  infant.actuators.push_back(toe_motor("right_toes", 1.805));
-  add_ankle_actuators(infant, Side::kLeft);
-  infant.actuators.push_back(toe_motor("left_toes", 1.774));
-  infant.actuators.push_back(toe_motor("left_big_toe", 1.805));
+  // Actuators: the finger table per hand; upstream v2 toe rows (BabyBench's kit swaps in v1's
+  // numbers), the left foot listing toes first.
+  add_actuators(
+      infant,
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        for (const FingerMotor& m : kFingerMotors) {
+          infant.actuators.push_back({.name = p + m.actuator,
+                                      .joint = p + m.joint,
+                                      .group = Group::kFingers,
+                                      .gear = m.gear,
+                                      .force_lo = m.lo,
+                                      .force_hi = m.hi,
+                                      .user = m.user});
+        }
+      },
+      [&](Side side) {
+        const bool right = side == Side::kRight;
+        infant.actuators.push_back(toe_motor(right ? "right_big_toe" : "left_toes", 1.774));
+        infant.actuators.push_back(toe_motor(right ? "right_toes" : "left_big_toe", 1.805));
+      });
 
   // Torque sensors: the arms' fingers after the wrist, the big toe after the toes.
   std::vector<std::string> arm_sensors = {"shoulder", "elbow", "wrist"};
