@@ -21,10 +21,8 @@ std::unique_ptr<TmaEnv> stump_env(const char* body) {
   return env;
 }
 
-// Random actions; episodes that end are reset outside the timing.
-void BM_StumpTracksStep(benchmark::State& state, const char* body) {
-  const auto holder = stump_env(body);
-  TmaEnv& env = *holder;
+// Env steps on random actions; episodes that end are reset outside the timing.
+void time_random_steps(benchmark::State& state, TmaEnv& env) {
   Rng rng(1);
   std::vector<double> a(env.action_size());
   for (auto _ : state) {
@@ -36,6 +34,10 @@ void BM_StumpTracksStep(benchmark::State& state, const char* body) {
       state.ResumeTiming();
     }
   }
+}
+
+void BM_StumpTracksStep(benchmark::State& state, const char* body) {
+  time_random_steps(state, *stump_env(body));
 }
 BENCHMARK_CAPTURE(BM_StumpTracksStep, old_classic_bipedal, "old_classic_bipedal");
 BENCHMARK_CAPTURE(BM_StumpTracksStep, small_bipedal, "small_bipedal");
@@ -83,17 +85,7 @@ void BM_ParkourStep(benchmark::State& state, const char* body) {
   TmaEnv env(TmaOptions{.env = EnvId::kParkour, .body = body});
   env.set_environment({{"input_vector", {-0.15, 0.8, 0.1}}, {"water_level", {1.0}}});
   env.reset(0);
-  Rng rng(1);
-  std::vector<double> a(env.action_size());
-  for (auto _ : state) {
-    for (double& v : a) v = rng.uniform(-1, 1);
-    const TmaStep r = env.step(a);
-    if (r.terminated || r.truncated) {
-      state.PauseTiming();
-      env.reset();
-      state.ResumeTiming();
-    }
-  }
+  time_random_steps(state, env);
 }
 BENCHMARK_CAPTURE(BM_ParkourStep, fish, "fish");
 

@@ -43,6 +43,21 @@ struct RunResult {
   std::string out;  // what it printed on stdout (and stderr when the command merges it)
 };
 
+// The message lines of a command's output: without the progress bar (its '[###...]' lines and
+// carriage returns) and blank lines.
+inline std::vector<std::string> message_lines(const std::string& out) {
+  std::vector<std::string> lines;
+  size_t at = 0;
+  for (size_t end; (end = out.find('\n', at)) != std::string::npos; at = end + 1) {
+    std::string line = out.substr(at, end - at);
+    const size_t cr = line.rfind('\r');
+    if (cr != std::string::npos) line = line.substr(cr + 1);
+    if (line.starts_with("[")) continue;  // the progress bar
+    if (line.find_first_not_of(' ') != std::string::npos) lines.push_back(line);
+  }
+  return lines;
+}
+
 // Runs a shell command.
 inline RunResult run(const std::string& command) {
   RunResult r;

@@ -250,16 +250,8 @@ void run(const IllustrateOptions& o) {
     if (curriculum) {
       JsonlWriter book(dir / "teacher.jsonl", /*append=*/false);
       for (const teach::EpisodeRecord& e : curriculum->take_episodes())
-        book.write({{"kind", "train"},
-                    {"episode", e.episode},
-                    {"env_steps", e.env_steps},
-                    {"task", e.task},
-                    {"return", e.ret},
-                    {"length", e.length},
-                    {"success", e.success}});
-      book.write({{"kind", "dump"},
-                  {"env_steps", curriculum->env_steps()},
-                  {"teacher", curriculum->teacher_dump()}});
+        book.write(teach::train_line(e));
+      book.write(teach::dump_line(curriculum->env_steps(), curriculum->teacher_dump()));
       book.flush();
       std::printf("curriculum: %ld episodes booked in %s\n", curriculum->episodes(),
                   (dir / "teacher.jsonl").c_str());

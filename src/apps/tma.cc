@@ -177,6 +177,12 @@ train::StudentEnv tma_student_env(const RunOptions& ro) {
   return env;
 }
 
+// The environment and embodiment options of `random` and `run`.
+void add_env_options(CLI::App* cmd, std::string& env, std::string& body) {
+  cmd->add_option("--env", env, "stump-tracks | parkour (or the reference ids)");
+  cmd->add_option("--embodiment", body, "Embodiment (see `cradle tma info`)");
+}
+
 }  // namespace
 
 void register_tma(CLI::App& app) {
@@ -193,8 +199,7 @@ void register_tma(CLI::App& app) {
   };
   auto ro = std::make_shared<RandomOptions>();
   CLI::App* random = tma_cmd->add_subcommand("random", "One random-policy episode");
-  random->add_option("--env", ro->env, "stump-tracks | parkour (or the reference ids)");
-  random->add_option("--embodiment", ro->body, "Embodiment (see `cradle tma info`)");
+  add_env_options(random, ro->env, ro->body);
   random->add_option("--task", ro->tasks, "Task parameter name=value[,v2,v3] (repeatable)");
   random->add_option("--video", ro->video, "Write the episode to this .mp4 / .avi");
   random->add_option("--steps", ro->steps, "Episode step cap")->check(CLI::Range(1, 1000000));
@@ -294,8 +299,7 @@ void register_tma(CLI::App& app) {
   auto rn = std::make_shared<RunOptions>();
   CLI::App* run = tma_cmd->add_subcommand("run", "Train a student with a teacher (run.py)");
   run->add_option("--exp_name", rn->exp_name, "Experiment name (default run folder)");
-  run->add_option("--env", rn->env, "stump-tracks | parkour (or the reference ids)");
-  run->add_option("--embodiment", rn->body, "Embodiment (see `cradle tma info`)");
+  add_env_options(run, rn->env, rn->body);
   run->add_option("--student", rn->student, "sac | ppo (the reference presets)");
   run->add_option("--teacher", rn->teacher,
                   "Random, ADR, ALP-GMM, Covar-GMM, RIAC, Self-Paced, GoalGAN, Setter-Solver");

@@ -85,7 +85,7 @@ void JsonlWriter::flush(bool sync) {
   }
 }
 
-std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file) {
+std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file, const JsonlCheck& check) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw UserError("cannot read " + file.string());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -104,6 +104,12 @@ std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file) {
     if (entry.is_discarded()) {
       if (last) break;  // cut short by a crash mid-write
       throw UserError(file.string() + ":" + std::to_string(line_no) + ": malformed JSON line");
+    }
+    if (check) {
+      const std::string problem = check(entry);
+      if (!problem.empty()) {
+        throw UserError(file.string() + ":" + std::to_string(line_no) + ": " + problem);
+      }
     }
     entries.push_back(std::move(entry));
   }

@@ -3,8 +3,10 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 namespace cradle {
@@ -35,9 +37,14 @@ class JsonlWriter {
   std::unique_ptr<std::FILE, Closer> out_;
 };
 
+// What is wrong with an entry ("" when nothing is).
+using JsonlCheck = std::function<std::string(const nlohmann::json& entry)>;
+
 // Every line of a JSON-lines file, in order; blank lines are skipped. A malformed last line with
-// no final newline (a crash mid-write) is ignored; any other malformed line is a UserError naming
-// the file and line number, as is a missing file.
-std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file);
+// no final newline (a crash mid-write) is ignored; any other malformed line, and an entry that
+// `check` (when given) finds wrong, is a UserError naming the file and line number, as is a
+// missing file.
+std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file,
+                                       const JsonlCheck& check = {});
 
 }  // namespace cradle

@@ -1,9 +1,7 @@
 #include "eval/log_check.h"
 
-#include <fstream>
-#include <iterator>
-
 #include "core/error.h"
+#include "core/jsonl.h"
 
 namespace cradle::eval {
 namespace {
@@ -57,31 +55,8 @@ std::string entry_problem(const nlohmann::json& entry, Behavior behavior, int ng
 
 std::vector<nlohmann::json> read_training_log(const std::filesystem::path& file, Behavior behavior,
                                               int ngeom) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw UserError("cannot read " + file.string());
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw UserError("cannot read " + file.string());
-  std::vector<nlohmann::json> entries;
-  size_t line_no = 0;
-  for (size_t at = 0; at < text.size();) {
-    ++line_no;
-    const size_t end = text.find('\n', at);
-    const bool last = end == std::string::npos;
-    const std::string_view line(text.data() + at, (last ? text.size() : end) - at);
-    at = last ? text.size() : end + 1;
-    if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
-    nlohmann::json entry = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
-    if (entry.is_discarded()) {
-      if (last) break;  // cut short by a crash mid-write
-      throw UserError(file.string() + ":" + std::to_string(line_no) + ": malformed JSON line");
-    }
-    const std::string problem = entry_problem(entry, behavior, ngeom);
-    if (!problem.empty()) {
-      throw UserError(file.string() + ":" + std::to_string(line_no) + ": " + problem);
-    }
-    entries.push_back(std::move(entry));
-  }
-  return entries;
+  return read_jsonl(
+      file, [&](const nlohmann::json& entry) { return entry_problem(entry, behavior, ngeom); });
 }
 
 void check_training_entries(const std::vector<nlohmann::json>& entries, Behavior behavior,

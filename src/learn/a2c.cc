@@ -41,6 +41,8 @@ using A2cSettings = OnPolicySettings<A2cConfig>;
 A2cSettings parse_settings(const LearnerOptions& options) {
   A2cSettings settings = parse_on_policy_settings<A2cConfig>(options);
   if (settings.own.n_steps < 1) throw UserError("a2c: n_steps must be positive");
+  // Short rollouts: report about every 2,048 steps per env.
+  settings.loop.report_every = std::max(1, 2048 / settings.own.n_steps);
   return settings;
 }
 
@@ -50,15 +52,7 @@ class A2c final : public OnPolicyLearner {
 
  private:
   A2c(VecEnv& env, const LearnerOptions& options, A2cSettings settings)
-      : OnPolicyLearner("a2c", env, options,
-                        {.learning_rate = settings.own.learning_rate,
-                         .anneal_lr = settings.own.anneal_lr,
-                         .n_steps = settings.own.n_steps,
-                         .gamma = settings.own.gamma,
-                         .gae_lambda = settings.own.gae_lambda,
-                         // Short rollouts: report about every 2,048 steps per env.
-                         .report_every = std::max(1, 2048 / settings.own.n_steps)},
-                        settings.observation, settings.policy, settings.text),
+      : OnPolicyLearner("a2c", env, options, settings),
         config_(settings.own),
         optimizer_(std::vector<torch::Tensor>{parameters().tensor()},
                    torch::optim::RMSpropOptions(config_.learning_rate)
@@ -70,37 +64,27 @@ class A2c final : public OnPolicyLearner {
 
   // One gradient step on the whole rollout.
   std::map<std::string, double> update() override {
-    const RolloutBuffer& buffer = this->buffer();
-    const torch::Tensor rows = buffer.valid_rows();
+    const torch::Tensor rows = buffer().valid_rows();
     // Data-parallel: a rank without a transition still joins the all-reduce, with a zero gradient.
     if (agree_max(sync(), static_cast<double>(rows.size(0))) == 0) return {};
     if (rows.size(0) == 0) {
       gradient_step(torch::Tensor(), config_.max_grad_norm);
       return {};
     }
-    const ObsBatch observations = buffer.observations.select(rows);
-    const torch::Tensor actions = buffer.actions.index_select(0, rows);
-    const torch::Tensor returns = buffer.returns.index_select(0, rows);
-    torch::Tensor advantages = buffer.advantages.index_select(0, rows);
-    if (config_.normalize_advantage && rows.size(0) > 1) advantages = standardize(advantages);
-
-    const GaussianActorCriticImpl::Output out = policy()->forward(observations);
-    const torch::Tensor log_probs = policy()->log_prob(out.mean, actions);
+    const Batch b = evaluate(rows, config_.normalize_advantage);
 
     // Policy gradient with the advantage as the baseline-corrected return.
-    const torch::Tensor policy_loss = -(advantages * log_probs).mean();
-    const torch::Tensor value_loss = (returns - out.value).square().mean();
-    const torch::Tensor entropy = policy()->entropy();
-    const torch::Tensor total =
-        policy_loss - config_.ent_coef * entropy + config_.vf_coef * value_loss;
+    const torch::Tensor policy_loss = -(b.advantages * b.log_probs).mean();
+    const torch::Tensor value_loss = (b.returns - b.out.value).square().mean();
+    const Loss loss = actor_critic_loss(policy_loss, value_loss, config_.ent_coef, config_.vf_coef);
 
-    gradient_step(total, config_.max_grad_norm);
+    gradient_step(loss.total, config_.max_grad_norm);
 
     return {{"policy_loss", policy_loss.item<double>()},
             {"value_loss", value_loss.item<double>()},
-            {"entropy", entropy.item<double>()},
-            {"loss", total.item<double>()},
-            {"std", torch::exp(policy()->log_std()).mean().item<double>()}};
+            {"entropy", loss.entropy.item<double>()},
+            {"loss", loss.total.item<double>()},
+            {"std", policy_std()}};
   }
 
   const A2cConfig config_;

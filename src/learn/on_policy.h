@@ -38,31 +38,6 @@
 
 namespace cradle::learn {
 
-// Every setting of an on-policy learner: the algorithm's own (`Own`, with a bind(table)), the
-// observation's and the policy network's.
-template <typename Own>
-struct OnPolicySettings {
-  Own own;
-  ObservationConfig observation;
-  PolicyConfig policy;
-  std::string text;  // every value, "name = value" lines
-};
-
-// Binds every setting, applies the overrides strictly (UserError for an unknown name or a bad
-// value); the algorithm checks its own values after.
-template <typename Own>
-OnPolicySettings<Own> parse_on_policy_settings(const LearnerOptions& options) {
-  apply_torch_options(options);
-  OnPolicySettings<Own> settings;
-  Hyperparameters table;
-  settings.own.bind(table);
-  settings.observation.bind(table);
-  settings.policy.bind(table);
-  table.apply(options.hyperparameters);
-  settings.text = table.to_text();
-  return settings;
-}
-
 // The loop's settings, from the algorithm's config.
 struct OnPolicyLoop {
   double learning_rate = 3e-4;
@@ -73,6 +48,39 @@ struct OnPolicyLoop {
   // Rewards scaled by the return normaliser (learn/return_normalizer.h), after the reward hook.
   bool normalize_returns = false;
 };
+
+// Every setting of an on-policy learner: the algorithm's own (`Own`, with a bind(table)), the
+// loop's (taken from it), the observation's and the policy network's.
+template <typename Own>
+struct OnPolicySettings {
+  Own own;
+  OnPolicyLoop loop;
+  ObservationConfig observation;
+  PolicyConfig policy;
+  std::string text;  // every value, "name = value" lines
+};
+
+// Binds every setting, applies the overrides strictly (UserError for an unknown name or a bad
+// value) and copies the loop's settings, which every `Own` holds under the same names; the
+// algorithm checks its own values after and sets the loop's others.
+template <typename Own>
+OnPolicySettings<Own> parse_on_policy_settings(const LearnerOptions& options) {
+  apply_torch_options(options);
+  OnPolicySettings<Own> settings;
+  Hyperparameters table;
+  settings.own.bind(table);
+  settings.observation.bind(table);
+  settings.policy.bind(table);
+  table.apply(options.hyperparameters);
+  settings.text = table.to_text();
+  const Own& own = settings.own;
+  settings.loop.learning_rate = own.learning_rate;
+  settings.loop.anneal_lr = own.anneal_lr;
+  settings.loop.n_steps = own.n_steps;
+  settings.loop.gamma = own.gamma;
+  settings.loop.gae_lambda = own.gae_lambda;
+  return settings;
+}
 
 // Standardised advantages: (A - mean) / (std + 1e-8).
 inline torch::Tensor standardize(const torch::Tensor& advantages) {
@@ -202,20 +210,20 @@ class OnPolicyLearner : public Learner {
   }
 
  protected:
+  template <typename Own>
   OnPolicyLearner(std::string algorithm, VecEnv& env, const LearnerOptions& options,
-                  const OnPolicyLoop& loop, const ObservationConfig& observation,
-                  const PolicyConfig& policy, std::string text)
+                  const OnPolicySettings<Own>& settings)
       : algorithm_(std::move(algorithm)),
-        text_(std::move(text)),
-        loop_(loop),
-        observation_(observation),
+        text_(settings.text),
+        loop_(settings.loop),
+        observation_(settings.observation),
         env_(env),
         generator_(at::make_generator<at::CPUGeneratorImpl>(options.seed)),
-        pipeline_(env.observation_space(), observation, find_touch(env)),
-        policy_(pipeline_.shape(), env.action_space().size(), policy, generator_),
+        pipeline_(env.observation_space(), observation_, find_touch(env)),
+        policy_(pipeline_.shape(), env.action_space().size(), settings.policy, generator_),
         parameters_(*policy_),
-        buffer_(loop.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
-        returns_(make_return_normalizer(loop, env, options)),
+        buffer_(loop_.n_steps, env.num_envs(), pipeline_.shape(), env.action_space().size()),
+        returns_(make_return_normalizer(loop_, env, options)),
         collector_(env, pipeline_, chain_reward_hooks(options.reward_hook, returns_.get())),
         scratch_(ObsBatch::zeros(pipeline_.shape(), 1)),
         update_threads_(update_threads(options, pipeline_.shape())),
@@ -227,6 +235,41 @@ class OnPolicyLearner : public Learner {
   // The update on the rollout in buffer() (advantages and returns computed); returns its losses
   // and diagnostics by name (TrainStats::losses).
   virtual std::map<std::string, double> update() = 0;
+
+  // What an update reads of the rollout's `rows` (advantages standardised when asked and there
+  // are two or more), and the current policy on them.
+  struct Batch {
+    torch::Tensor actions, old_log_probs, old_values, returns, advantages;
+    GaussianActorCriticImpl::Output out;  // the current mean and value
+    torch::Tensor log_probs;              // of the actions, under the current policy
+  };
+  Batch evaluate(const torch::Tensor& rows, bool normalize_advantage) {
+    Batch b;
+    const ObsBatch observations = buffer_.observations.select(rows);
+    b.actions = buffer_.actions.index_select(0, rows);
+    b.old_log_probs = buffer_.log_probs.index_select(0, rows);
+    b.old_values = buffer_.values.index_select(0, rows);
+    b.returns = buffer_.returns.index_select(0, rows);
+    b.advantages = buffer_.advantages.index_select(0, rows);
+    if (normalize_advantage && rows.size(0) > 1) b.advantages = standardize(b.advantages);
+    b.out = policy_->forward(observations);
+    b.log_probs = policy_->log_prob(b.out.mean, b.actions);
+    return b;
+  }
+
+  // The actor-critic objective L = L_policy - ent_coef * entropy + vf_coef * L_value, with the
+  // policy's current entropy.
+  struct Loss {
+    torch::Tensor entropy, total;
+  };
+  Loss actor_critic_loss(const torch::Tensor& policy_loss, const torch::Tensor& value_loss,
+                         double ent_coef, double vf_coef) {
+    const torch::Tensor entropy = policy_->entropy();
+    return {entropy, policy_loss - ent_coef * entropy + vf_coef * value_loss};
+  }
+
+  // The mean standard deviation of the Gaussian policy, for the report.
+  double policy_std() { return torch::exp(policy_->log_std()).mean().item<double>(); }
 
   // One optimiser step on `loss` (undefined: a zero gradient, for a data-parallel rank with no
   // transition), the gradient averaged over the ranks and its norm clipped to max_grad_norm.

@@ -54,6 +54,7 @@ PpoSettings parse_settings(const LearnerOptions& options) {
   if (c.normalize_advantage && c.batch_size < 2) {
     throw UserError("ppo: normalize_advantage needs batch_size > 1");
   }
+  settings.loop.normalize_returns = c.normalize_returns;
   return settings;
 }
 
@@ -63,14 +64,7 @@ class Ppo final : public OnPolicyLearner {
 
  private:
   Ppo(VecEnv& env, const LearnerOptions& options, PpoSettings settings)
-      : OnPolicyLearner("ppo", env, options,
-                        {.learning_rate = settings.own.learning_rate,
-                         .anneal_lr = settings.own.anneal_lr,
-                         .n_steps = settings.own.n_steps,
-                         .gamma = settings.own.gamma,
-                         .gae_lambda = settings.own.gae_lambda,
-                         .normalize_returns = settings.own.normalize_returns},
-                        settings.observation, settings.policy, settings.text),
+      : OnPolicyLearner("ppo", env, options, settings),
         config_(settings.own),
         optimizer_(std::vector<torch::Tensor>{parameters().tensor()},
                    torch::optim::AdamOptions(config_.learning_rate).eps(config_.adam_eps)) {
@@ -86,8 +80,7 @@ class Ppo final : public OnPolicyLearner {
 
   // n_epochs passes of minibatch gradient steps over the rollout's valid rows.
   std::map<std::string, double> update() override {
-    const RolloutBuffer& buffer = this->buffer();
-    const torch::Tensor rows = buffer.valid_rows();
+    const torch::Tensor rows = buffer().valid_rows();
     const long n = rows.size(0);
     // Data-parallel: every rank takes as many minibatches as the rank with the most valid rows
     // (the others wrap around their shuffled rows), so the gradient all-reduces pair up.
@@ -103,19 +96,11 @@ class Ppo final : public OnPolicyLearner {
       for (long begin = 0; begin < rows_per_epoch; begin += config_.batch_size) {
         const torch::Tensor index =
             order.slice(0, begin, std::min(rows_per_epoch, begin + config_.batch_size));
-        const ObsBatch observations = buffer.observations.select(index);
-        const torch::Tensor actions = buffer.actions.index_select(0, index);
-        const torch::Tensor old_log_probs = buffer.log_probs.index_select(0, index);
-        const torch::Tensor old_values = buffer.values.index_select(0, index);
-        const torch::Tensor returns = buffer.returns.index_select(0, index);
-        torch::Tensor advantages = buffer.advantages.index_select(0, index);
-        if (config_.normalize_advantage && index.size(0) > 1) advantages = standardize(advantages);
-
-        const GaussianActorCriticImpl::Output out = policy()->forward(observations);
-        const torch::Tensor log_probs = policy()->log_prob(out.mean, actions);
+        const Batch b = evaluate(index, config_.normalize_advantage);
+        const torch::Tensor& advantages = b.advantages;
 
         // Clipped surrogate: -mean(min(r A, clip(r, 1 - eps, 1 + eps) A)).
-        const torch::Tensor log_ratio = log_probs - old_log_probs;
+        const torch::Tensor log_ratio = b.log_probs - b.old_log_probs;
         const torch::Tensor ratio = torch::exp(log_ratio);
         const torch::Tensor clipped =
             torch::clamp(ratio, 1.0 - config_.clip_range, 1.0 + config_.clip_range);
@@ -123,16 +108,14 @@ class Ppo final : public OnPolicyLearner {
             -torch::min(ratio * advantages, clipped * advantages).mean();
 
         // Value loss against the GAE returns, the prediction optionally kept near the old value.
-        torch::Tensor values = out.value;
+        torch::Tensor values = b.out.value;
         if (config_.clip_range_vf > 0) {
-          values = old_values +
-                   torch::clamp(values - old_values, -config_.clip_range_vf, config_.clip_range_vf);
+          values = b.old_values + torch::clamp(values - b.old_values, -config_.clip_range_vf,
+                                               config_.clip_range_vf);
         }
-        const torch::Tensor value_loss = (returns - values).square().mean();
-
-        const torch::Tensor entropy = policy()->entropy();
+        const torch::Tensor value_loss = (b.returns - values).square().mean();
         const torch::Tensor total =
-            policy_loss - config_.ent_coef * entropy + config_.vf_coef * value_loss;
+            actor_critic_loss(policy_loss, value_loss, config_.ent_coef, config_.vf_coef).total;
 
         // Approximate KL(old || new) = E[(r - 1) - log r] (Schulman's low-variance estimator).
         // Data-parallel: the ranks' mean, so that every rank stops at the same minibatch.
@@ -163,7 +146,7 @@ class Ppo final : public OnPolicyLearner {
             {"clip_fraction", clip_sum / m},
             {"loss", loss},
             {"entropy", policy()->entropy().item<double>()},
-            {"std", torch::exp(policy()->log_std()).mean().item<double>()},
+            {"std", policy_std()},
             {"explained_variance", explained_variance(rows)},
             {"minibatches", static_cast<double>(minibatches)}};
   }

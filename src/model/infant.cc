@@ -195,14 +195,20 @@ void add_leg(Infant& infant, Side side, const LegMasses& m) {
   infant.bodies.push_back(lower);
 }
 
-std::vector<Joint> ankle_joints(Side side) {
+void add_foot_body(Infant& infant, Side side, std::vector<Geom> geoms) {
   const double s = side == Side::kRight ? 1 : -1;
   const std::string p = side_prefix(side);
-  return {
+  Body foot{.name = p + "foot", .parent = p + "lower_leg", .pos = {0, 0, -.177}};
+  foot.geoms = std::move(geoms);
+  foot.geoms[1].friction = kSoleGrip;
+  foot.geoms[2].friction = kSoleGrip;
+  foot.joints = {
       hinge(p + "foot1", {0, -1, 0}, {0, 0, .015}, -63, 32, -10, 1.29, 0.6, .019, .003),
       hinge(p + "foot2", {s, 0, 0}, {0, 0, .015}, -33, 31, 0, 0.96, 0.37, .011, .0025),
       hinge(p + "foot3", {0, 0, s}, {0, 0, .015}, -20, 30, 0, 1.15, 0.38, .012, .002),
   };
+  foot.sites.push_back({.name = "torque_" + p + "ankle"});
+  infant.bodies.push_back(foot);
 }
 
 namespace {
@@ -217,7 +223,6 @@ Actuator motor(std::string name, std::string joint, Group group, double gear, do
           .force_hi = hi,
           .user = user};
 }
-}  // namespace
 
 void add_body_head_eye_actuators(Infant& infant) {
   auto& a = infant.actuators;
@@ -290,12 +295,36 @@ void add_ankle_actuators(Infant& infant, Side side) {
       motor(p + "foot_rotation", p + "foot3", Group::kFeet, 1.2, -1, 1, {2.688, 3.868, 3.625}));
 }
 
-void add_head_and_trunk_sensors(Infant& infant) {
+}  // namespace
+
+void add_actuators(Infant& infant, const std::function<void(Side)>& add_fingers,
+                   const std::function<void(Side)>& add_toes) {
+  add_body_head_eye_actuators(infant);
+  add_arm_actuators(infant);
+  add_hand_actuators(infant);
+  for (Side side : {Side::kRight, Side::kLeft}) add_fingers(side);
+  add_leg_actuators(infant);
+  for (Side side : {Side::kRight, Side::kLeft}) {
+    add_ankle_actuators(infant, side);
+    add_toes(side);
+  }
+}
+
+void add_torque_sensors(Infant& infant, const std::vector<std::string>& arm_joints,
+                        const std::vector<std::string>& leg_joints) {
   infant.torque_sensors.insert(infant.torque_sensors.end(), {{"neck", "torque_neck"},
                                                              {"left_eye", "torque_left_eye"},
                                                              {"right_eye", "torque_right_eye"},
                                                              {"trunk_upper", "torque_ub"},
                                                              {"trunk_lower", "torque_lb"}});
+  for (const std::vector<std::string>* joints : {&arm_joints, &leg_joints}) {
+    for (Side side : {Side::kRight, Side::kLeft}) {
+      const std::string p = side_prefix(side);
+      for (const std::string& joint : *joints) {
+        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
+      }
+    }
+  }
 }
 
 void add_tendons_and_contacts(Infant& infant) {

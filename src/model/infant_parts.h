@@ -1,6 +1,7 @@
 // Building blocks shared by the v1 and v2 tables (internal to src/model).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,18 +39,24 @@ void add_trunk_and_head(Infant& infant, const TrunkMasses& masses);
 void add_arm(Infant& infant, Side side, double upper_mass, double lower_mass);
 // Upper and lower leg of one side.
 void add_leg(Infant& infant, Side side, const LegMasses& masses);
-// The three ankle hinges of one foot.
-std::vector<Joint> ankle_joints(Side side);
+// Soles and toes grip twice as hard as skin (sliding, torsional, rolling friction).
+inline constexpr Vec3 kSoleGrip{2, 0.02, 0.01};
+// The foot body of one side below its lower leg, `geoms` being its heel cylinder, sole box and
+// ball cylinder (the last two gripping with kSoleGrip), with the three ankle hinges and their
+// torque site.
+void add_foot_body(Infant& infant, Side side, std::vector<Geom> geoms);
 
-// Actuators common to both versions, appended in BabyBench group order.
-void add_body_head_eye_actuators(Infant& infant);
-void add_arm_actuators(Infant& infant);
-void add_hand_actuators(Infant& infant);
-void add_leg_actuators(Infant& infant);
-void add_ankle_actuators(Infant& infant, Side side);
+// Every actuator in BabyBench group order: body, head, eyes, arms, hands, the fingers of each side
+// (`add_fingers`, the version's), legs, then each side's ankle followed by its toes (`add_toes`,
+// the version's); right side before left.
+void add_actuators(Infant& infant, const std::function<void(Side)>& add_fingers,
+                   const std::function<void(Side)>& add_toes);
 
-// Torque sensors of the head, eyes and trunk (the first five of the reference order).
-void add_head_and_trunk_sensors(Infant& infant);
+// Every torque sensor in the reference's sensordata order: head, eyes and trunk, then the arms'
+// and then the legs' joints, right side before left, each side's in the order of `arm_joints` /
+// `leg_joints` (sites "torque_<side>_<joint>").
+void add_torque_sensors(Infant& infant, const std::vector<std::string>& arm_joints,
+                        const std::vector<std::string>& leg_joints);
 // Trunk-coupling and head-limit tendons, the hip/torso contact pair and eye exclusions.
 void add_tendons_and_contacts(Infant& infant);
 

@@ -1,6 +1,5 @@
 // MIMo v1: mitten hands (one palm body and one "fingers" body per hand) and one toes body per
 // foot. Numbers are the reference model's (mimo_core.md §1.2-1.3, §1.6, §2.1).
-#include <array>
 #include <string>
 
 #include "model/infant.h"
@@ -39,28 +38,22 @@ void add_mitten(Infant& infant, Side side) {
   infant.bodies.push_back(fingers);
 }
 
-// Foot body and one toes body; soles and toes grip twice as hard as skin.
+// Foot body and one toes body.
 void add_foot(Infant& infant, Side side) {
   const std::string p = side_prefix(side);
-  const Vec3 grip{2, 0.02, 0.01};
-  Body foot{.name = p + "foot", .parent = p + "lower_leg", .pos = {0, 0, -.177}};
-  foot.geoms = {
-      cylinder("", {.0249, .0099}, {-0.016, 0, 0}, {0, 0, 0}, .03219, "sock"),
-      box("", {.035, .025, .01}, {0.019, 0, 0}, {0, 0, 0}, .05850, "sock"),
-      cylinder("", {.0099, .0248}, {.054, 0, 0}, {90, 0, 0}, .01268, "sock"),
-  };
-  foot.geoms[1].friction = grip;
-  foot.geoms[2].friction = grip;
-  foot.joints = ankle_joints(side);
-  foot.sites.push_back({.name = "torque_" + p + "ankle"});
-  infant.bodies.push_back(foot);
+  add_foot_body(infant, side,
+                {
+                    cylinder("", {.0249, .0099}, {-0.016, 0, 0}, {0, 0, 0}, .03219, "sock"),
+                    box("", {.035, .025, .01}, {0.019, 0, 0}, {0, 0, 0}, .05850, "sock"),
+                    cylinder("", {.0099, .0248}, {.054, 0, 0}, {90, 0, 0}, .01268, "sock"),
+                });
 
   Body toes{.name = p + "toes", .parent = p + "foot", .pos = {.054, 0, 0}};
   toes.geoms = {
       box("", {.007, .0249, .0099}, {.007, 0, 0}, {0, 0, 0}, .01084, "sock"),
       cylinder("", {.01, .025}, {.014, 0, 0}, {90, 0, 0}, .01226, "sock"),
   };
-  for (Geom& g : toes.geoms) g.friction = grip;
+  for (Geom& g : toes.geoms) g.friction = kSoleGrip;
   toes.joints.push_back(
       hinge(p + "toes", {0, -1, 0}, {0, 0, 0}, -60, 80, 0, .106, .04, .005, .0005));
   toes.sites.push_back({.name = "torque_" + p + "toes"});
@@ -84,44 +77,32 @@ Infant make_mimo_v1() {
     add_foot(infant, side);
   }
 
-  // Actuators in BabyBench group order: body, head, eyes, arms, hands, fingers, legs, feet.
-  add_body_head_eye_actuators(infant);
-  add_arm_actuators(infant);
-  add_hand_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    const std::string p = side_prefix(side);
-    infant.actuators.push_back({.name = p + "fingers",
-                                .joint = p + "fingers",
-                                .group = Group::kFingers,
-                                .gear = .69,
-                                .force_lo = -1,
-                                .force_hi = .33,
-                                .user = {3.019, 6.854, 2.551}});
-  }
-  add_leg_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    add_ankle_actuators(infant, side);
-    const std::string p = side_prefix(side);
-    infant.actuators.push_back({.name = p + "toes",
-                                .joint = p + "toes",
-                                .group = Group::kFeet,
-                                .gear = .33,
-                                .force_lo = -1,
-                                .force_hi = .3,
-                                .user = {1.290, 2.947, .8440}});
-  }
+  // Actuators: one mitten motor per hand, one toes motor per foot.
+  add_actuators(
+      infant,
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        infant.actuators.push_back({.name = p + "fingers",
+                                    .joint = p + "fingers",
+                                    .group = Group::kFingers,
+                                    .gear = .69,
+                                    .force_lo = -1,
+                                    .force_hi = .33,
+                                    .user = {3.019, 6.854, 2.551}});
+      },
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        infant.actuators.push_back({.name = p + "toes",
+                                    .joint = p + "toes",
+                                    .group = Group::kFeet,
+                                    .gear = .33,
+                                    .force_lo = -1,
+                                    .force_hi = .3,
+                                    .user = {1.290, 2.947, .8440}});
+      });
 
-  // Torque sensors in the reference's sensordata order.
-  add_head_and_trunk_sensors(infant);
-  for (const auto& joints : {std::array<const char*, 4>{"shoulder", "elbow", "wrist", "fingers"},
-                             std::array<const char*, 4>{"hip", "knee", "ankle", "toes"}}) {
-    for (Side side : {Side::kRight, Side::kLeft}) {
-      const std::string p = side_prefix(side);
-      for (const char* joint : joints) {
-        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
-      }
-    }
-  }
+  add_torque_sensors(infant, {"shoulder", "elbow", "wrist", "fingers"},
+                     {"hip", "knee", "ankle", "toes"});
 
   add_tendons_and_contacts(infant);
   return infant;

@@ -206,23 +206,17 @@ void add_hand(Infant& infant, Side side) {
   add_thumb(infant, side);
 }
 
-// Foot with a big-toe and a toes body; soles and toes grip twice as hard as skin. The reference
-// lists big_toe first on the right foot and toes first on the left.
+// Foot with a big-toe and a toes body. The reference lists big_toe first on the right foot and
+// toes first on the left.
 void add_foot(Infant& infant, Side side) {
   const double s = side == Side::kRight ? 1 : -1;
   const std::string p = side_prefix(side);
-  const Vec3 grip{2, 0.02, 0.01};
-  Body foot = make_body(p + "foot", p + "lower_leg", {0, 0, -.177});
-  foot.geoms = {
-      cylinder("", {.0249, .0101}, {-0.007, 0, 0}, {0, 0, 0}, .03225, "sock"),
-      box("", {.030, .025, .01}, {0.023, 0, 0}, {0, 0, 0}, .04923, "sock"),
-      cylinder("", {.0101, .0251}, {.053, 0, 0}, {90, 0, 0}, .01312, "sock"),
-  };
-  foot.geoms[1].friction = grip;
-  foot.geoms[2].friction = grip;
-  foot.joints = ankle_joints(side);
-  foot.sites.push_back({.name = "torque_" + p + "ankle"});
-  infant.bodies.push_back(foot);
+  add_foot_body(infant, side,
+                {
+                    cylinder("", {.0249, .0101}, {-0.007, 0, 0}, {0, 0, 0}, .03225, "sock"),
+                    box("", {.030, .025, .01}, {0.023, 0, 0}, {0, 0, 0}, .04923, "sock"),
+                    cylinder("", {.0101, .0251}, {.053, 0, 0}, {90, 0, 0}, .01312, "sock"),
+                });
 
   // A toe body: a box and a rounded tip across the foot; the big toe is medial (+y on the right).
   auto toe = [&](const std::string& name, double y, double box_half_width, double box_mass,
@@ -232,7 +226,7 @@ void add_foot(Infant& infant, Side side) {
         box("", {.0095, box_half_width, .0099}, {.0095, 0, 0}, {0, 0, 0}, box_mass, "sock"),
         cylinder("", {.01, tip_half_length}, {.019, 0, 0}, {90, 0, 0}, tip_mass, "sock"),
     };
-    for (Geom& g : b.geoms) g.friction = grip;
+    for (Geom& g : b.geoms) g.friction = kSoleGrip;
     b.joints.push_back(hinge(p + name, {0, -1, 0}, {0, 0, 0}, -60, 80, 0, .053, .02, .002, .0001));
     b.sites.push_back({.name = "torque_" + p + name});
     return b;
@@ -325,47 +319,32 @@ Infant make_mimo_v2() {
     add_foot(infant, side);
   }
 
-  // Actuators in BabyBench group order: body, head, eyes, arms, hands, fingers, legs, feet.
-  add_body_head_eye_actuators(infant);
-  add_arm_actuators(infant);
-  add_hand_actuators(infant);
-  for (Side side : {Side::kRight, Side::kLeft}) {
-    const std::string p = side_prefix(side);
-    for (const FingerMotor& m : kFingerMotors) {
-      infant.actuators.push_back({.name = p + m.actuator,
-                                  .joint = p + m.joint,
-                                  .group = Group::kFingers,
-                                  .gear = m.gear,
-                                  .force_lo = m.lo,
-                                  .force_hi = m.hi,
-                                  .user = m.user});
-    }
-  }
-  add_leg_actuators(infant);
-  // Upstream v2 toe rows (BabyBench's kit swaps in v1's numbers); the left foot lists toes first.
-  add_ankle_actuators(infant, Side::kRight);
-  infant.actuators.push_back(toe_motor("right_big_toe", 1.774));
-  infant.actuators.push_back(toe_motor("right_toes", 1.805));
-  add_ankle_actuators(infant, Side::kLeft);
-  infant.actuators.push_back(toe_motor("left_toes", 1.774));
-  infant.actuators.push_back(toe_motor("left_big_toe", 1.805));
+  // Actuators: the finger table per hand; upstream v2 toe rows (BabyBench's kit swaps in v1's
+  // numbers), the left foot listing toes first.
+  add_actuators(
+      infant,
+      [&](Side side) {
+        const std::string p = side_prefix(side);
+        for (const FingerMotor& m : kFingerMotors) {
+          infant.actuators.push_back({.name = p + m.actuator,
+                                      .joint = p + m.joint,
+                                      .group = Group::kFingers,
+                                      .gear = m.gear,
+                                      .force_lo = m.lo,
+                                      .force_hi = m.hi,
+                                      .user = m.user});
+        }
+      },
+      [&](Side side) {
+        const bool right = side == Side::kRight;
+        infant.actuators.push_back(toe_motor(right ? "right_big_toe" : "left_toes", 1.774));
+        infant.actuators.push_back(toe_motor(right ? "right_toes" : "left_big_toe", 1.805));
+      });
 
-  // Torque sensors in the reference's sensordata order.
-  add_head_and_trunk_sensors(infant);
-  const std::vector<std::string> arm_sensors = [] {
-    std::vector<std::string> names = {"shoulder", "elbow", "wrist"};
-    names.insert(names.end(), kFingerSensors.begin(), kFingerSensors.end());
-    return names;
-  }();
-  const std::vector<std::string> leg_sensors = {"hip", "knee", "ankle", "toes", "big_toe"};
-  for (const std::vector<std::string>* joints : {&arm_sensors, &leg_sensors}) {
-    for (Side side : {Side::kRight, Side::kLeft}) {
-      const std::string p = side_prefix(side);
-      for (const std::string& joint : *joints) {
-        infant.torque_sensors.push_back({p + joint, "torque_" + p + joint});
-      }
-    }
-  }
+  // Torque sensors: the arms' fingers after the wrist, the big toe after the toes.
+  std::vector<std::string> arm_sensors = {"shoulder", "elbow", "wrist"};
+  arm_sensors.insert(arm_sensors.end(), kFingerSensors.begin(), kFingerSensors.end());
+  add_torque_sensors(infant, arm_sensors, {"hip", "knee", "ankle", "toes", "big_toe"});
 
   add_tendons_and_contacts(infant);
   return infant;

@@ -418,6 +418,15 @@ long TeacherController::episodes() const {
   return episodes_;
 }
 
+nlohmann::json train_line(const EpisodeRecord& e) {
+  return {{"kind", "train"}, {"episode", e.episode}, {"env_steps", e.env_steps}, {"task", e.task},
+          {"return", e.ret}, {"length", e.length},   {"success", e.success}};
+}
+
+nlohmann::json dump_line(long env_steps, nlohmann::json teacher) {
+  return {{"kind", "dump"}, {"env_steps", env_steps}, {"teacher", std::move(teacher)}};
+}
+
 std::vector<EpisodeRecord> TeacherController::take_episodes() {
   std::lock_guard lock(mutex_);
   return std::exchange(new_episodes_, {});

@@ -108,6 +108,11 @@ struct EpisodeRecord {
   bool success = false;
 };
 
+// teacher.jsonl's lines: a booked training episode ("kind": "train"), and the teacher's dump at
+// env_steps ("kind": "dump").
+nlohmann::json train_line(const EpisodeRecord& e);
+nlohmann::json dump_line(long env_steps, nlohmann::json teacher);
+
 // A curriculum snapshot: `samples` non-exploratory tasks (real space) at env_steps.
 struct PeriodicalRecord {
   long env_steps = 0;

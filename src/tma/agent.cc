@@ -59,24 +59,44 @@ double Agent::mass() const {
   return m;
 }
 
-// The table of embodiments: sizes the environments need before building one.
+// The table of embodiments: sizes the environments need before building one, and the builder
+// (the bodies that are never critical, and the climbers, adapted to the one signature).
 const std::vector<Embodiment>& embodiments() {
   static const std::vector<Embodiment> table = {
-      {"old_classic_bipedal", BodyKind::kWalker, 64 / kScale, 2.5, true, 34 / kScale, 0},
-      {"small_bipedal", BodyKind::kWalker, 20 / kScale, 37 / kScale, false, 17 / kScale, 0},
-      {"old_big_quadru", BodyKind::kWalker, 96 / kScale, (102 - 8) / kScale, true, 51 / kScale, 0},
-      {"spider", BodyKind::kWalker, 100 / kScale, 24 / kScale, false, 20 / kScale, 0},
-      {"millipede", BodyKind::kWalker, 80 / kScale, 23 / kScale, false, 10 / kScale, 0},
-      {"profile_chimpanzee", BodyKind::kWalker, 24 / kScale, 68 / kScale, false, 28 / kScale, 0},
+      {"old_classic_bipedal", BodyKind::kWalker, 64 / kScale, 2.5, true, 34 / kScale, 0,
+       build_old_classic_bipedal},
+      {"small_bipedal", BodyKind::kWalker, 20 / kScale, 37 / kScale, false, 17 / kScale, 0,
+       build_small_bipedal},
+      {"old_big_quadru", BodyKind::kWalker, 96 / kScale, (102 - 8) / kScale, true, 51 / kScale, 0,
+       build_old_big_quadru},
+      {"spider", BodyKind::kWalker, 100 / kScale, 24 / kScale, false, 20 / kScale, 0, build_spider},
+      {"millipede", BodyKind::kWalker, 80 / kScale, 23 / kScale, false, 10 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) { build_millipede(a, w, x, y); }},
+      {"profile_chimpanzee", BodyKind::kWalker, 24 / kScale, 68 / kScale, false, 28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_profile_chimpanzee(a, w, x, y);
+       }},
       {"climbing_profile_chimpanzee", BodyKind::kClimber, 24 / kScale, 68 / kScale, false,
-       28 / kScale, 0},
+       28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_climbing_chimpanzee(a, w, x, y, /*legs=*/true);
+       }},
       {"climbing_chest_profile_chimpanzee", BodyKind::kClimber, 24 / kScale, 68 / kScale, false,
-       28 / kScale, 0},
-      {"fish", BodyKind::kSwimmer, 35 / kScale, 9 / kScale, false, 0, 1.0},
-      {"amphibious_bipedal", BodyKind::kAmphibian, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
-      {"classic_bipedal", BodyKind::kWalker, 64 / kScale, 71 / kScale, false, 34 / kScale, 0},
-      {"big_quadru", BodyKind::kWalker, 96 / kScale, 105 / kScale, false, 51 / kScale, 0},
-      {"wheel", BodyKind::kWalker, 20 / kScale, 30 / kScale, false, 10 / kScale, 0},
+       28 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_climbing_chimpanzee(a, w, x, y, /*legs=*/false);
+       }},
+      {"fish", BodyKind::kSwimmer, 35 / kScale, 9 / kScale, false, 0, 1.0,
+       [](Agent& a, b2World& w, double x, double y, bool) { build_fish(a, w, x, y); }},
+      {"amphibious_bipedal", BodyKind::kAmphibian, 64 / kScale, 71 / kScale, false, 34 / kScale, 0,
+       [](Agent& a, b2World& w, double x, double y, bool) {
+         build_amphibious_bipedal(a, w, x, y);
+       }},
+      {"classic_bipedal", BodyKind::kWalker, 64 / kScale, 71 / kScale, false, 34 / kScale, 0,
+       build_classic_bipedal},
+      {"big_quadru", BodyKind::kWalker, 96 / kScale, 105 / kScale, false, 51 / kScale, 0,
+       build_big_quadru},
+      {"wheel", BodyKind::kWalker, 20 / kScale, 30 / kScale, false, 10 / kScale, 0, build_wheel},
   };
   return table;
 }
@@ -106,33 +126,7 @@ void build_agent(std::string_view name, b2World& world, double x0, double y0, do
   agent = Agent{};
   agent.kind = e.kind;
   const double y = y0 + e.spawn_dy;
-  if (name == "old_classic_bipedal") {
-    build_old_classic_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "classic_bipedal") {
-    build_classic_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "small_bipedal") {
-    build_small_bipedal(agent, world, x0, y, stump_tracks);
-  } else if (name == "amphibious_bipedal") {
-    build_amphibious_bipedal(agent, world, x0, y);
-  } else if (name == "old_big_quadru") {
-    build_old_big_quadru(agent, world, x0, y, stump_tracks);
-  } else if (name == "big_quadru") {
-    build_big_quadru(agent, world, x0, y, stump_tracks);
-  } else if (name == "wheel") {
-    build_wheel(agent, world, x0, y, stump_tracks);
-  } else if (name == "spider") {
-    build_spider(agent, world, x0, y, stump_tracks);
-  } else if (name == "millipede") {
-    build_millipede(agent, world, x0, y);
-  } else if (name == "profile_chimpanzee") {
-    build_profile_chimpanzee(agent, world, x0, y);
-  } else if (name == "climbing_profile_chimpanzee") {
-    build_climbing_chimpanzee(agent, world, x0, y, /*legs=*/true);
-  } else if (name == "climbing_chest_profile_chimpanzee") {
-    build_climbing_chimpanzee(agent, world, x0, y, /*legs=*/false);
-  } else if (name == "fish") {
-    build_fish(agent, world, x0, y);
-  }
+  e.build(agent, world, x0, y, stump_tracks);
   // The initial push acts during the first world step only (Box2D clears forces after a step).
   for (b2Body* b : agent.pushed) b->ApplyForceToCenter(b2Vec2(static_cast<float>(force), 0), true);
 }
@@ -223,21 +217,36 @@ void motor(Agent& agent, b2RevoluteJoint* joint, double speed, const b2Body* con
                                .contact = contact ? tag_of(contact) : nullptr});
 }
 
-b2Body* chimpanzee_trunk(Agent& agent, b2World& world, double x0, double y0, const Fixture& fixture,
-                         Rgb c1, Rgb c2) {
-  const auto at = [](double x, double y) {
-    return b2Vec2(static_cast<float>(x), static_cast<float>(y));
-  };
+Chimpanzee chimpanzee(Agent& agent, b2World& world, double x0, double y0, bool legs,
+                      bool critical_feet) {
+  constexpr double kPi = std::numbers::pi;
+  const Rgb hull1{0.5f, 0.4f, 0.9f}, hull2{0.3f, 0.3f, 0.5f};
+  const Rgb leg1{0.5f, 0.2f, 0.4f}, leg2{0.3f, 0.1f, 0.2f};
+  agent.torque = 100;
+  agent.torque_penalty = 3.5e-4 / 5;
+  agent.remove_head_angle = true;
+  Chimpanzee c;
+  // Head and torso collide with terrain only, like the limbs.
+  const Fixture body_fd{.density = 5.0, .friction = 0.1, .mask = 0x1};
   const b2PolygonShape head_shape = pixel_polygon({{-5, 10}, {5, 10}, {5, -10}, {-5, -10}});
   b2Body* head = part(agent, world, at(x0, y0 + 45 / kScale / 2 + 20 / kScale / 2 + 0.2), 0,
-                      head_shape, fixture, true, true, c1, c2);
+                      head_shape, body_fd, true, true, hull1, hull2);
   agent.head = head;
   agent.pushed.push_back(head);
   const b2PolygonShape torso_shape = pixel_polygon({{-12, 25}, {12, 25}, {8, -20}, {-8, -20}});
-  b2Body* torso = part(agent, world, at(x0, y0), 0, torso_shape, fixture, true, true, c1, c2);
-  joint(world, head, torso, at(x0, y0 + 45 / kScale / 2), -0.1 * std::numbers::pi,
-        0.1 * std::numbers::pi, false);
-  return torso;
+  c.torso = part(agent, world, at(x0, y0), 0, torso_shape, body_fd, true, true, hull1, hull2);
+  joint(world, head, c.torso, at(x0, y0 + 45 / kScale / 2), -0.1 * kPi, 0.1 * kPi, false);
+  const double down = Chimpanzee::kLegDown, h = Chimpanzee::kLimbH;
+  for (int k = 0; legs && k < 2; ++k) {
+    b2Body* upper = part(agent, world, at(x0, y0 - h / 2 - down), 0, c.upper, c.limb_fd, false,
+                         false, leg1, leg2);
+    motor(agent, joint(world, c.torso, upper, at(x0, y0 - down), -0.3 * kPi, 0.6 * kPi, true), 4);
+    b2Body* lower = part(agent, world, at(x0, y0 - h * 1.5 - down), 0, c.lower, c.limb_fd, true,
+                         critical_feet, leg1, leg2);
+    motor(agent, joint(world, upper, lower, at(x0, y0 - h - down), -0.75 * kPi, -0.1, true), 6,
+          lower, 1.0);
+  }
+  return c;
 }
 
 }  // namespace build

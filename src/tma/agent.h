@@ -53,7 +53,11 @@ struct Agent {
   double mass() const;  // every part and sensor
 };
 
-// What the environments need to place an embodiment before building it.
+// Builds an embodiment's parts with its origin at (x0, y0); `stump_tracks` makes walker hulls
+// critical.
+using Builder = void (*)(Agent&, b2World&, double x0, double y0, bool stump_tracks);
+
+// What the environments need to place an embodiment before building it, and its builder.
 struct Embodiment {
   std::string name;
   BodyKind kind;
@@ -62,6 +66,7 @@ struct Embodiment {
   bool old_morphology;   // spawned at TERRAIN_HEIGHT + 2 * leg_h in Stump Tracks
   double leg_h;
   double spawn_dy;  // added to the spawn height by the body itself (fish: +1)
+  Builder build;
 };
 
 // Every embodiment's name, in the seed's order first.
@@ -103,10 +108,22 @@ b2RevoluteJoint* joint_local(b2World& world, b2Body* a, b2Body* b, b2Vec2 local_
                              double lower, double upper);
 void motor(Agent& agent, b2RevoluteJoint* joint, double speed, const b2Body* contact = nullptr,
            double correction = 0);
-// The chimpanzees' critical head (the reference object) on a passive neck over their torso, both
-// with `fixture`; returns the torso.
-b2Body* chimpanzee_trunk(Agent& agent, b2World& world, double x0, double y0, const Fixture& fixture,
-                         Rgb c1, Rgb c2);
+// What the chimpanzees share: limb sizes (world units), the torso their limbs hang from, the limb
+// fixture (terrain only) and the limb shapes.
+struct Chimpanzee {
+  static constexpr double kLegDown = 12 / kScale, kArmUp = 22 / kScale;
+  static constexpr double kLimbW = 8 / kScale, kLimbH = 28 / kScale;
+  static constexpr double kHandW = 4 / kScale, kHandH = 8 / kScale;
+  b2Body* torso = nullptr;
+  Fixture limb_fd{.mask = 0x1};
+  b2PolygonShape upper = box(kLimbW / 2, kLimbH / 2), lower = box(0.8 * kLimbW / 2, kLimbH / 2);
+  b2PolygonShape hand = box(kHandW / 2, kHandH / 2);
+};
+// A chimpanzee up to its arms (which differ): torque, the critical head (the reference object) on a
+// passive neck over the torso and, with `legs`, two identical legs (they overlap at spawn, as in
+// the reference) whose lower parts are critical when `critical_feet`.
+Chimpanzee chimpanzee(Agent& agent, b2World& world, double x0, double y0, bool legs,
+                      bool critical_feet);
 
 }  // namespace build
 

@@ -63,6 +63,11 @@ struct Tag {
   Rgb color1, color2;
 };
 
+// A point in world units as Box2D's float vector.
+inline b2Vec2 at(double x, double y) {
+  return b2Vec2(static_cast<float>(x), static_cast<float>(y));
+}
+
 inline Tag* tag_of(const b2Body* body) {
   return reinterpret_cast<Tag*>(const_cast<b2Body*>(body)->GetUserData().pointer);
 }

@@ -137,14 +137,13 @@ void render(const TmaEnv& env, int width, int height, bool draw_lidars,
   }
   // Start flag.
   const double fx = kTerrainStep * 3, fy1 = kTerrainHeight, fy2 = fy1 + 50 / kScale;
-  auto pt = [](double x, double y) { return b2Vec2(static_cast<float>(x), static_cast<float>(y)); };
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_set_line_width(cr, 2.0 * v.k / kScale);
-  v.move(pt(fx, fy1));
-  v.line(pt(fx, fy2));
+  v.move(at(fx, fy1));
+  v.line(at(fx, fy2));
   cairo_stroke(cr);
-  const b2Vec2 flag[3] = {pt(fx, fy2), pt(fx, fy2 - 10 / kScale),
-                          pt(fx + 25 / kScale, fy2 - 5 / kScale)};
+  const b2Vec2 flag[3] = {at(fx, fy2), at(fx, fy2 - 10 / kScale),
+                          at(fx + 25 / kScale, fy2 - 5 / kScale)};
   path(v, flag, 3);
   cairo_set_source_rgb(cr, 0.9, 0.2, 0);
   cairo_fill_preserve(cr);

@@ -10,7 +10,6 @@ namespace cradle::tma {
 void build_fish(Agent& agent, b2World& world, double x0, double y0) {
   using build::Fixture;
   constexpr double kPi = std::numbers::pi;
-  auto at = [](double x, double y) { return b2Vec2(static_cast<float>(x), static_cast<float>(y)); };
   agent.torque = 80;
   agent.torque_penalty = 3.5e-4;
   agent.remove_head_angle = true;
@@ -23,28 +22,31 @@ void build_fish(Agent& agent, b2World& world, double x0, double y0) {
                              Fixture{.density = density, .friction = 0.1}, true, false, c1, c2);
   agent.head = hull;
   const Fixture part_fd{.density = density};
-  const b2PolygonShape p1_shape = build::pixel_polygon({{-8, 9}, {8, 12}, {8, -12}, {-8, -9}});
-  const b2PolygonShape p2_shape = build::pixel_polygon({{-8, 4}, {8, 9}, {8, -9}, {-8, -4}});
-  const b2PolygonShape p3_shape = build::pixel_polygon({{-4, 2}, {4, 4}, {4, -4}, {-4, -2}});
-  // Body segments chained behind the head; every joint is a contact-checking motor.
-  b2Body* p1 =
-      build::part(agent, world, at(x0 - 0.85, y0), 0, p1_shape, part_fd, true, false, b1, b2);
-  build::motor(agent,
-               build::joint_local(world, hull, p1, at(-17.5 / kScale, 0), at(8 / kScale, 0),
-                                  -0.1 * kPi, 0.2 * kPi),
-               6, p1);
-  b2Body* p2 = build::part(agent, world, at(x0 - 41.5 / kScale, y0), 0, p2_shape, part_fd, true,
-                           false, b1, b2);
-  build::motor(agent,
-               build::joint_local(world, p1, p2, at(-8 / kScale, 0), at(8 / kScale, 0), -0.15 * kPi,
-                                  0.15 * kPi),
-               6, p2);
-  b2Body* p3 = build::part(agent, world, at(x0 - 53.5 / kScale, y0), 0, p3_shape, part_fd, true,
-                           false, b1, b2);
-  build::motor(agent,
-               build::joint_local(world, p2, p3, at(-8 / kScale, 0), at(4 / kScale, 0), -0.3 * kPi,
-                                  0.3 * kPi),
-               6, p3);
+  // Body segments chained behind the head (spawn x, shape, local anchors on the previous part and
+  // on the segment, joint limits in pi); every joint is a contact-checking motor.
+  struct Segment {
+    double x;
+    b2PolygonShape shape;
+    double anchor_a, anchor_b, lower, upper;
+  };
+  const Segment segments[] = {
+      {x0 - 0.85, build::pixel_polygon({{-8, 9}, {8, 12}, {8, -12}, {-8, -9}}), -17.5, 8, -0.1,
+       0.2},
+      {x0 - 41.5 / kScale, build::pixel_polygon({{-8, 4}, {8, 9}, {8, -9}, {-8, -4}}), -8, 8, -0.15,
+       0.15},
+      {x0 - 53.5 / kScale, build::pixel_polygon({{-4, 2}, {4, 4}, {4, -4}, {-4, -2}}), -8, 4, -0.3,
+       0.3},
+  };
+  b2Body* previous = hull;
+  for (const Segment& g : segments) {
+    b2Body* segment =
+        build::part(agent, world, at(g.x, y0), 0, g.shape, part_fd, true, false, b1, b2);
+    build::motor(agent,
+                 build::joint_local(world, previous, segment, at(g.anchor_a / kScale, 0),
+                                    at(g.anchor_b / kScale, 0), g.lower * kPi, g.upper * kPi),
+                 6, segment);
+    previous = segment;
+  }
   // The fin hangs under the head, tilted back by 0.2 pi.
   const b2PolygonShape fin_shape = build::box(1 / kScale, 10 / kScale);
   const double fin_angle = -0.2 * kPi, fin_h = 10 / kScale;

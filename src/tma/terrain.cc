@@ -8,8 +8,6 @@
 namespace cradle::tma {
 namespace {
 
-b2Vec2 at(double x, double y) { return b2Vec2(static_cast<float>(x), static_cast<float>(y)); }
-
 b2Body* static_body(b2World& world, Tag& tag) {
   b2BodyDef def;
   def.userData.pointer = reinterpret_cast<uintptr_t>(&tag);

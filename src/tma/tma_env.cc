@@ -186,7 +186,7 @@ b2Vec2 TmaEnv::spawn() const {
   const double y = options_.env == EnvId::kStumpTracks && body_->old_morphology
                        ? kTerrainHeight + 2 * body_->leg_h
                        : kTerrainHeight + body_->center_height;
-  return b2Vec2(static_cast<float>(x), static_cast<float>(y));
+  return at(x, y);
 }
 
 std::span<const double> TmaEnv::reset(std::optional<std::uint64_t> seed) {

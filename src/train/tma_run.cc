@@ -376,13 +376,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   // Booked episodes and snapshots to teacher.jsonl as they come.
   auto drain_teacher = [&] {
     for (const teach::EpisodeRecord& e : controller->take_episodes()) {
-      teacher_log.write({{"kind", "train"},
-                         {"episode", e.episode},
-                         {"env_steps", e.env_steps},
-                         {"task", e.task},
-                         {"return", e.ret},
-                         {"length", e.length},
-                         {"success", e.success}});
+      teacher_log.write(teach::train_line(e));
       train_return_sum += e.ret;
       ++train_returns;
     }
@@ -436,8 +430,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
              << csv_cell(updates_done) << "," << csv_cell(train_env->teacher_seconds()) << "\n";
     train_return_sum = 0;
     train_returns = 0;
-    teacher_log.write(
-        {{"kind", "dump"}, {"env_steps", steps}, {"teacher", controller->teacher_dump()}});
+    teacher_log.write(teach::dump_line(steps, controller->teacher_dump()));
     // The checkpoint: the learner, then the state naming the logs' sizes at this point.
     progress.flush();
     test_csv.flush();

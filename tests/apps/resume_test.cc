@@ -38,19 +38,7 @@ std::string read_text(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Lines of the message without the progress bar (its '[###...]' lines and carriage returns).
-std::vector<std::string> message_lines(const std::string& out) {
-  std::vector<std::string> lines;
-  size_t at = 0;
-  for (size_t end; (end = out.find('\n', at)) != std::string::npos; at = end + 1) {
-    std::string line = out.substr(at, end - at);
-    const size_t cr = line.rfind('\r');
-    if (cr != std::string::npos) line = line.substr(cr + 1);
-    if (line.starts_with("[")) continue;  // the progress bar
-    if (!line.empty() && line.find_first_not_of(' ') != std::string::npos) lines.push_back(line);
-  }
-  return lines;
-}
+using cradle::test::message_lines;
 
 // A quick self-touch training config (no vision, 100-step episodes) writing to dir/run.
 std::string training_config(const fs::path& dir) {

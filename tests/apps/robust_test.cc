@@ -29,24 +29,15 @@ CliRun cradle(const std::string& args) {
 
 fs::path temp_dir(const std::string& tag) { return cradle::test::fresh_dir("robust_" + tag); }
 
-// Lines of output without the progress bar (its '[###...]' lines and carriage returns).
-int message_lines(const std::string& out) {
-  int n = 0;
-  size_t at = 0;
-  for (size_t end; (end = out.find('\n', at)) != std::string::npos; at = end + 1) {
-    std::string line = out.substr(at, end - at);
-    const size_t cr = line.rfind('\r');
-    if (cr != std::string::npos) line = line.substr(cr + 1);
-    if (line.starts_with("[")) continue;  // the progress bar
-    n += line.find_first_not_of(' ') != std::string::npos;
-  }
-  return n;
+// How many message lines the output holds.
+int message_count(const std::string& out) {
+  return static_cast<int>(cradle::test::message_lines(out).size());
 }
 
 void expect_one_line_error(const std::string& args) {
   const CliRun r = cradle(args);
   EXPECT_EQ(r.status, 1) << args << "\n" << r.out;
-  EXPECT_EQ(message_lines(r.out), 1) << args << "\n" << r.out;
+  EXPECT_EQ(message_count(r.out), 1) << args << "\n" << r.out;
   EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << "\n" << r.out;
   EXPECT_LT(r.seconds, 60) << args;
 }
@@ -116,7 +107,7 @@ TEST(Robust, BadTrainingLogLinesNameTheirLine) {
     const CliRun r =
         cradle("evaluate --config " + config + " --episodes 1 --duration 2 --no-render");
     EXPECT_EQ(r.status, 1) << bad << "\n" << r.out;
-    EXPECT_EQ(message_lines(r.out), 1) << bad << "\n" << r.out;
+    EXPECT_EQ(message_count(r.out), 1) << bad << "\n" << r.out;
     EXPECT_NE(r.out.find("training.jsonl:2:"), std::string::npos) << bad << "\n" << r.out;
   }
   fs::remove_all(dir);

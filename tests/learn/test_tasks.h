@@ -68,41 +68,70 @@ inline std::shared_ptr<const mjModel> compile_inline(const char* name, const cha
   return {model, mj_deleteModel};
 }
 
-// One compiled model shared by every CartPole (read-only after loading).
-inline std::shared_ptr<const mjModel> cartpole_model() {
-  return compile_inline("cartpole.xml", kCartPoleXml, sizeof(kCartPoleXml));
-}
-
-class CartPole final : public envs::Env {
+// What both tasks share: one compiled model (read-only), their own data and rng, a one-dimensional
+// float32 action box and the step count of the episode.
+class MujocoTask : public envs::Env {
  public:
-  static constexpr double kMaxAngle = 0.2;  // rad
-  static constexpr int kFrameSkip = 2;
-
-  CartPole(std::shared_ptr<const mjModel> model, int max_steps, bool with_image)
-      : model_(std::move(model)),
-        data_(mj_makeData(model_.get()), mj_deleteData),
-        space_(make_space(with_image)),
-        action_space_(Box::uniform({1}, DType::kFloat32, -3.0, 3.0)),
-        obs_(space_),
-        max_steps_(max_steps),
-        with_image_(with_image) {}
-
   const DictSpace& observation_space() const override { return space_; }
   const Box& action_space() const override { return action_space_; }
   const envs::ObservationBuffers& observation() const override { return obs_; }
   const envs::Info& info() const override { return info_; }
 
+  // A fresh episode from the task's random initial state.
   void reset(std::optional<std::uint64_t> seed) override {
     if (seed) rng_.seed_with(*seed);
     mj_resetData(model_.get(), data_.get());
-    for (int i = 0; i < 2; ++i) {
-      data_->qpos[i] = rng_.uniform(-0.01, 0.01);
-      data_->qvel[i] = rng_.uniform(-0.01, 0.01);
-    }
+    draw_initial_state();
     mj_forward(model_.get(), data_.get());
     info_.steps = 0;
     observe();
   }
+
+ protected:
+  MujocoTask(std::shared_ptr<const mjModel> model, DictSpace space, double max_action,
+             int max_steps)
+      : model_(std::move(model)),
+        data_(mj_makeData(model_.get()), mj_deleteData),
+        space_(std::move(space)),
+        action_space_(Box::uniform({1}, DType::kFloat32, -max_action, max_action)),
+        obs_(space_),
+        max_steps_(max_steps) {}
+
+  virtual void draw_initial_state() = 0;  // qpos and qvel, from rng_
+  virtual void observe() = 0;             // obs_ from data_
+
+  std::shared_ptr<const mjModel> model_;
+  std::unique_ptr<mjData, void (*)(mjData*)> data_;
+  DictSpace space_;
+  Box action_space_;
+  envs::ObservationBuffers obs_;
+  envs::Info info_;
+  Rng rng_;
+  int max_steps_;
+};
+
+// `envs` tasks built from one compiled model, stepped in the calling thread.
+template <typename Task, typename... Args>
+std::unique_ptr<ThreadedVecEnv> make_tasks(int envs, const std::shared_ptr<const mjModel>& model,
+                                           const Args&... args) {
+  std::vector<std::unique_ptr<envs::Env>> list;
+  for (int i = 0; i < envs; ++i) list.push_back(std::make_unique<Task>(model, args...));
+  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+}
+
+// One compiled model shared by every CartPole (read-only after loading).
+inline std::shared_ptr<const mjModel> cartpole_model() {
+  return compile_inline("cartpole.xml", kCartPoleXml, sizeof(kCartPoleXml));
+}
+
+class CartPole final : public MujocoTask {
+ public:
+  static constexpr double kMaxAngle = 0.2;  // rad
+  static constexpr int kFrameSkip = 2;
+
+  CartPole(std::shared_ptr<const mjModel> model, int max_steps, bool with_image)
+      : MujocoTask(std::move(model), make_space(with_image), 3.0, max_steps),
+        with_image_(with_image) {}
 
   envs::StepResult step(std::span<const double> action) override {
     data_->ctrl[0] = std::clamp(action[0], -3.0, 3.0);
@@ -127,7 +156,14 @@ class CartPole final : public envs::Env {
     return space;
   }
 
-  void observe() {
+  void draw_initial_state() override {
+    for (int i = 0; i < 2; ++i) {
+      data_->qpos[i] = rng_.uniform(-0.01, 0.01);
+      data_->qvel[i] = rng_.uniform(-0.01, 0.01);
+    }
+  }
+
+  void observe() override {
     const std::span<double> state = obs_.f64(0);
     state[0] = data_->qpos[0];
     state[1] = data_->qpos[1];
@@ -148,25 +184,13 @@ class CartPole final : public envs::Env {
     }
   }
 
-  std::shared_ptr<const mjModel> model_;
-  std::unique_ptr<mjData, void (*)(mjData*)> data_;
-  DictSpace space_;
-  Box action_space_;
-  envs::ObservationBuffers obs_;
-  envs::Info info_;
-  Rng rng_;
-  int max_steps_;
   bool with_image_;
 };
 
 // `envs` CartPoles stepped in the calling thread.
 inline std::unique_ptr<ThreadedVecEnv> make_cartpoles(int envs, int max_steps,
                                                       bool with_image = false) {
-  const std::shared_ptr<const mjModel> model = cartpole_model();
-  std::vector<std::unique_ptr<envs::Env>> list;
-  for (int i = 0; i < envs; ++i)
-    list.push_back(std::make_unique<CartPole>(model, max_steps, with_image));
-  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+  return make_tasks<CartPole>(envs, cartpole_model(), max_steps, with_image);
 }
 
 inline constexpr char kPendulumXml[] = R"(
@@ -190,34 +214,14 @@ inline std::shared_ptr<const mjModel> pendulum_model() {
   return compile_inline("pendulum.xml", kPendulumXml, sizeof(kPendulumXml));
 }
 
-class Pendulum final : public envs::Env {
+class Pendulum final : public MujocoTask {
  public:
   static constexpr int kFrameSkip = 5;  // 0.05 s per step
   static constexpr double kMaxTorque = 2.0;
   static constexpr double kMaxSpeed = 8.0;  // rad/s, Gymnasium's clip
 
   Pendulum(std::shared_ptr<const mjModel> model, int max_steps)
-      : model_(std::move(model)),
-        data_(mj_makeData(model_.get()), mj_deleteData),
-        space_(make_space()),
-        action_space_(Box::uniform({1}, DType::kFloat32, -kMaxTorque, kMaxTorque)),
-        obs_(space_),
-        max_steps_(max_steps) {}
-
-  const DictSpace& observation_space() const override { return space_; }
-  const Box& action_space() const override { return action_space_; }
-  const envs::ObservationBuffers& observation() const override { return obs_; }
-  const envs::Info& info() const override { return info_; }
-
-  void reset(std::optional<std::uint64_t> seed) override {
-    if (seed) rng_.seed_with(*seed);
-    mj_resetData(model_.get(), data_.get());
-    data_->qpos[0] = rng_.uniform(-M_PI, M_PI);
-    data_->qvel[0] = rng_.uniform(-1.0, 1.0);
-    mj_forward(model_.get(), data_.get());
-    info_.steps = 0;
-    observe();
-  }
+      : MujocoTask(std::move(model), make_space(), kMaxTorque, max_steps) {}
 
   envs::StepResult step(std::span<const double> action) override {
     const double torque = std::clamp(action[0], -kMaxTorque, kMaxTorque);
@@ -243,29 +247,22 @@ class Pendulum final : public envs::Env {
     return space;
   }
 
-  void observe() {
+  void draw_initial_state() override {
+    data_->qpos[0] = rng_.uniform(-M_PI, M_PI);
+    data_->qvel[0] = rng_.uniform(-1.0, 1.0);
+  }
+
+  void observe() override {
     const std::span<double> state = obs_.f64(0);
     state[0] = std::cos(data_->qpos[0]);
     state[1] = std::sin(data_->qpos[0]);
     state[2] = data_->qvel[0];
   }
-
-  std::shared_ptr<const mjModel> model_;
-  std::unique_ptr<mjData, void (*)(mjData*)> data_;
-  DictSpace space_;
-  Box action_space_;
-  envs::ObservationBuffers obs_;
-  envs::Info info_;
-  Rng rng_;
-  int max_steps_;
 };
 
 // `envs` Pendulums stepped in the calling thread.
 inline std::unique_ptr<ThreadedVecEnv> make_pendulums(int envs, int max_steps) {
-  const std::shared_ptr<const mjModel> model = pendulum_model();
-  std::vector<std::unique_ptr<envs::Env>> list;
-  for (int i = 0; i < envs; ++i) list.push_back(std::make_unique<Pendulum>(model, max_steps));
-  return std::make_unique<ThreadedVecEnv>(std::move(list), /*threads=*/1);
+  return make_tasks<Pendulum>(envs, pendulum_model(), max_steps);
 }
 
 }  // namespace cradle::learn::testing

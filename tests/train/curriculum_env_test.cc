@@ -194,18 +194,27 @@ TEST(CurriculumEnv, RefusesATeachersParameterAsAnOption) {
   EXPECT_THROW(env.set_reset_options({{"gain", 1}}), UserError);
 }
 
-// A student whose value of an initial state is level * (1 + gain) (the Corridor's second
-// observation), level rising by `rise` at every valuation; NaN stands for no value function.
-class ValuedStudent final : public learn::Learner {
+// A student that neither learns nor acts, named `algorithm`; its value is the base Learner's (NaN).
+class IdleStudent : public learn::Learner {
  public:
-  explicit ValuedStudent(double rise) : rise_(rise) {}
-  std::string_view algorithm() const override { return "stub"; }
+  explicit IdleStudent(std::string_view algorithm) : algorithm_(algorithm) {}
+  std::string_view algorithm() const override { return algorithm_; }
   void learn(long, const learn::ProgressFn&) override {}
   long steps() const override { return 0; }
   void save(const std::filesystem::path&) const override {}
   void load(const std::filesystem::path&) override {}
   void act(const envs::ObservationBuffers&, std::span<double>, bool) override {}
   std::string config_text() const override { return ""; }
+
+ private:
+  std::string_view algorithm_;
+};
+
+// A student whose value of an initial state is level * (1 + gain) (the Corridor's second
+// observation), level rising by `rise` at every valuation; NaN stands for no value function.
+class ValuedStudent final : public IdleStudent {
+ public:
+  explicit ValuedStudent(double rise) : IdleStudent("stub"), rise_(rise) {}
   double value(const envs::ObservationBuffers& obs) override {
     ++valued;
     level_ += rise_;
@@ -266,16 +275,7 @@ TEST(CurriculumEnv, SelfPacedMovesTowardTheTargetAsTheStudentsValueRises) {
 
 TEST(CurriculumEnv, SelfPacedRefusesAStudentWithoutValue) {
   // The base Learner::value is NaN: the first update says which students can serve.
-  class NoValue final : public learn::Learner {
-   public:
-    std::string_view algorithm() const override { return "td3"; }
-    void learn(long, const learn::ProgressFn&) override {}
-    long steps() const override { return 0; }
-    void save(const std::filesystem::path&) const override {}
-    void load(const std::filesystem::path&) override {}
-    void act(const envs::ObservationBuffers&, std::span<double>, bool) override {}
-    std::string config_text() const override { return ""; }
-  } student;
+  IdleStudent student("td3");
   try {
     spdl_kls(student, 400);
     FAIL() << "no error";
