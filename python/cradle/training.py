@@ -66,6 +66,7 @@ def train(
     steps=100_000,
     envs=2,
     threads=0,
+    async_batch=0,
     seed=0,
     resume=False,
     randomize_start=False,
@@ -90,6 +91,8 @@ def train(
       step for these calls; their cost is the Python calls themselves (about a microsecond each
       plus the callable's own time, next to an env step of about 0.4 ms).
     hyperparameters: {name: value} overrides of the algorithm's hyperparameters (as --hp).
+    async_batch: K > 0 collects PPO/A2C rollouts asynchronously in batches of the first K of the
+      envs to finish (as --async-batch; 1 <= K < envs); 0: lock-step.
 
     Returns a dict: steps, seconds, steps_per_second, training_score, checkpoint, evaluation
     (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
@@ -98,9 +101,10 @@ def train(
     spec, terms = _split_intrinsic(intrinsic)
     hp = {str(k): str(v) for k, v in (hyperparameters or {}).items()}
     result = _cradle.train(
-        load_config(config), algo, spec, int(steps), int(envs), int(threads), int(seed),
-        bool(resume), bool(randomize_start), int(checkpoint_every), hp, int(eval_episodes),
-        int(eval_duration), bool(eval_render), bool(compare_random), bool(progress_bar), terms,
+        load_config(config), algo, spec, int(steps), int(envs), int(threads), int(async_batch),
+        int(seed), bool(resume), bool(randomize_start), int(checkpoint_every), hp,
+        int(eval_episodes), int(eval_duration), bool(eval_render), bool(compare_random),
+        bool(progress_bar), terms,
     )
     for key in ("evaluation", "random_evaluation"):
         if result[key] is not None:

@@ -109,8 +109,8 @@ class EnvStepper {
 // value of its observation then is its last value. Observation statistics and action noise are
 // taken in batch order, which timing decides, so such runs are not bitwise repeatable. The reward
 // hook sees each batch as a VecEnv of its own (BatchView: env j is the batch's j-th env id) with
-// the batch's actions and rewards, so a hook that keeps per-env state by position (the intrinsic
-// rewards) does not fit async collection.
+// the batch's actions and rewards, so a hook that keeps per-env state indexes it by
+// VecEnv::env_id (as the intrinsic rewards do).
 class RolloutCollector {
  public:
   RolloutCollector(VecEnv& env, ObservationPipeline& pipeline, RewardHook reward_hook);

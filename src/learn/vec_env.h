@@ -35,6 +35,9 @@ class VecEnv {
   virtual const envs::Info& info(int env) const = 0;
   virtual envs::Env& env(int env) = 0;
   virtual const envs::Env& env(int env) const = 0;
+  // The id of env `slot` in the underlying vector: the slot itself, except for views of part of
+  // a vector (BatchView). Per-env state kept across calls (intrinsic rewards) is indexed by it.
+  virtual int env_id(int slot) const { return slot; }
 };
 
 }  // namespace cradle::learn

@@ -373,6 +373,7 @@ AsyncVecEnv::Batch AsyncVecEnv::recv() {
     batch_terminated_[j] = terminated_[e];
     batch_truncated_[j] = truncated_[e];
   }
+  if (after_step_) after_step_();
   const size_t count = size;
   return {.ids = {ids_.data(), count},
           .rewards = {batch_rewards_.data(), count},
@@ -393,6 +394,8 @@ void AsyncVecEnv::reset(std::uint64_t seed) {
   held_count_ = 0;
   enqueue(all_ids_);
   take(n);
+  if (after_step_) after_step_();
+  if (after_reset_) after_reset_();
 }
 
 void AsyncVecEnv::step(std::span<const double> actions) {
@@ -408,6 +411,17 @@ void AsyncVecEnv::step(std::span<const double> actions) {
   }
   send(actions, all_ids_);
   take(n);
+  if (after_step_) after_step_();
+}
+
+void set_after_reset(VecEnv& vec, std::function<void()> fn) {
+  if (auto* threaded = dynamic_cast<ThreadedVecEnv*>(&vec)) {
+    threaded->set_after_reset(std::move(fn));
+  } else if (auto* async = dynamic_cast<AsyncVecEnv*>(&vec)) {
+    async->set_after_reset(std::move(fn));
+  } else {
+    throw std::invalid_argument("set_after_reset: not a ThreadedVecEnv or AsyncVecEnv");
+  }
 }
 
 void BatchView::reset(std::uint64_t) {

@@ -150,6 +150,12 @@ class AsyncVecEnv final : public VecEnv {
   envs::Env& env(int env) override { return *envs_[env]; }
   const envs::Env& env(int env) const override { return *envs_[env]; }
 
+  // Called on the calling thread after every recv(), reset() and step() (e.g. to commit a shared
+  // log in env order), as ThreadedVecEnv's.
+  void set_after_step(std::function<void()> fn) { after_step_ = std::move(fn); }
+  // Called after every reset(seed), after the after-step call (e.g. an intrinsic reward's reset).
+  void set_after_reset(std::function<void()> fn) { after_reset_ = std::move(fn); }
+
  private:
   enum class Job : std::uint8_t { kStep, kReset };
   // Queues held env ids (the caller's thread).
@@ -189,12 +195,18 @@ class AsyncVecEnv final : public VecEnv {
   int sleeping_workers_ = 0;
   int caller_wants_ = 0;  // > 0 while the caller sleeps for that many ready envs
   bool stop_ = false;
+  std::function<void()> after_step_, after_reset_;
   std::vector<std::thread> workers_;
 };
 
+// Sets the after-reset call of a ThreadedVecEnv or an AsyncVecEnv (std::invalid_argument for
+// another VecEnv).
+void set_after_reset(VecEnv& vec, std::function<void()> fn);
+
 // The batch of an AsyncVecEnv as a VecEnv of batch.size() envs: env j is the batch's env ids[j]
-// (its observation, info, and the batch's rewards and flags). For code written against VecEnv
-// (observation pipelines) on a batch; reset() and step() throw std::logic_error.
+// (its observation, info, and the batch's rewards and flags; env_id(j) = ids[j]). For code written
+// against VecEnv (observation pipelines, reward hooks) on a batch; reset() and step() throw
+// std::logic_error.
 class BatchView final : public VecEnv {
  public:
   BatchView(AsyncVecEnv& vec, const AsyncVecEnv::Batch& batch) : vec_(vec), batch_(batch) {}
@@ -212,6 +224,7 @@ class BatchView final : public VecEnv {
   const envs::Info& info(int env) const override { return vec_.info(batch_.ids[env]); }
   envs::Env& env(int env) override { return vec_.env(batch_.ids[env]); }
   const envs::Env& env(int env) const override { return vec_.env(batch_.ids[env]); }
+  int env_id(int slot) const override { return batch_.ids[slot]; }
 
  private:
   AsyncVecEnv& vec_;

@@ -264,16 +264,18 @@ class PyRewardHook {
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (terms_.empty()) return;
     const int envs = env.num_envs();
-    if (obs_.empty()) {
-      const std::vector<Entry> entries = entries_of(env.observation_space());
-      for (int i = 0; i < envs; ++i) {
-        py::dict d;
-        for (size_t k = 0; k < entries.size(); ++k) {
-          d[entries[k].key.c_str()] =
-              view_array(entries[k], env.observation(i).bytes(static_cast<int>(k)), py::tuple());
-        }
-        obs_.push_back(d);
+    // Views of each env's buffers, made at its first call (an async batch holds some envs).
+    for (int i = 0; i < envs; ++i) {
+      const size_t id = env.env_id(i);
+      if (id < obs_.size() && obs_[id]) continue;
+      if (entries_.empty()) entries_ = entries_of(env.observation_space());
+      if (id >= obs_.size()) obs_.resize(id + 1);
+      py::dict d;
+      for (size_t k = 0; k < entries_.size(); ++k) {
+        d[entries_[k].key.c_str()] =
+            view_array(entries_[k], env.observation(i).bytes(static_cast<int>(k)), py::tuple());
       }
+      obs_[id] = d;
     }
     const size_t dim = actions.size() / envs;
     for (int i = 0; i < envs; ++i) {
@@ -286,9 +288,9 @@ class PyRewardHook {
                 view_doubles(actions.data() + i * dim, static_cast<py::ssize_t>(dim), py::tuple());
             info = info_dict(env.info(i));
           }
-          r = t.fn(obs_[i], action, info).cast<double>();
+          r = t.fn(obs_[env.env_id(i)], action, info).cast<double>();
         } else {
-          r = t.fn(obs_[i]).cast<double>();
+          r = t.fn(obs_[env.env_id(i)]).cast<double>();
         }
         rewards[i] += t.weight * r;
       }
@@ -297,7 +299,8 @@ class PyRewardHook {
 
  private:
   std::vector<PyTerm> terms_;
-  std::vector<py::dict> obs_;  // per env: views of its observation buffers
+  std::vector<Entry> entries_;
+  std::vector<py::object> obs_;  // per env id: views of its observation buffers (dicts)
 };
 
 // A Python policy for evaluation: fn(obs dict) -> action, with fresh observation arrays.
@@ -355,15 +358,17 @@ void bind_learn(py::module_& m) {
   m.def(
       "train",
       [](const Config& config, const std::string& algorithm, const std::string& intrinsic,
-         long steps, int envs, int threads, std::uint64_t seed, bool resume, bool randomize_start,
-         long checkpoint_every, const std::map<std::string, std::string>& hyperparameters,
-         int eval_episodes, int eval_duration, bool eval_render, bool compare_random,
-         bool progress_bar, const py::list& terms) {
+         long steps, int envs, int threads, int async_batch, std::uint64_t seed, bool resume,
+         bool randomize_start, long checkpoint_every,
+         const std::map<std::string, std::string>& hyperparameters, int eval_episodes,
+         int eval_duration, bool eval_render, bool compare_random, bool progress_bar,
+         const py::list& terms) {
         train::TrainOptions o{.algorithm = algorithm,
                               .intrinsic = intrinsic,
                               .steps = steps,
                               .envs = envs,
                               .threads = threads,
+                              .async_batch = async_batch,
                               .seed = seed,
                               .resume = resume,
                               .randomize_start = randomize_start,
@@ -395,10 +400,10 @@ void bind_learn(py::module_& m) {
         return out;
       },
       py::arg("config"), py::arg("algorithm"), py::arg("intrinsic"), py::arg("steps"),
-      py::arg("envs"), py::arg("threads"), py::arg("seed"), py::arg("resume"),
-      py::arg("randomize_start"), py::arg("checkpoint_every"), py::arg("hyperparameters"),
-      py::arg("eval_episodes"), py::arg("eval_duration"), py::arg("eval_render"),
-      py::arg("compare_random"), py::arg("progress_bar"), py::arg("terms"),
+      py::arg("envs"), py::arg("threads"), py::arg("async_batch"), py::arg("seed"),
+      py::arg("resume"), py::arg("randomize_start"), py::arg("checkpoint_every"),
+      py::arg("hyperparameters"), py::arg("eval_episodes"), py::arg("eval_duration"),
+      py::arg("eval_render"), py::arg("compare_random"), py::arg("progress_bar"), py::arg("terms"),
       "Trains with the C++ learners (see cradle.train). Python reward terms are (fn, weight, "
       "full) tuples.");
 

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <stdexcept>
+#include <vector>
 
 #include "core/error.h"
 #include "envs/babybench.h"
@@ -41,7 +43,9 @@ namespace {
 
 // The vector, and each env's BabyBench face (for the training log's bookkeeping).
 TrainingVector make_vector(const Config& config, int num_envs, int threads, bool training,
-                           std::uint64_t seed, long continue_log, const EnvWrapper& wrap) {
+                           std::uint64_t seed, long continue_log, const EnvWrapper& wrap,
+                           int async_batch) {
+  using learn::AsyncVecEnv;
   using learn::ThreadedVecEnv;
   if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
   // One compiled model for all; one training log shared by all (it is thread-safe).
@@ -53,17 +57,27 @@ TrainingVector make_vector(const Config& config, int num_envs, int threads, bool
   // The log takes each env's entries in env order after every step, whatever thread ran first.
   if (out.log) out.log->set_slots(num_envs);
   auto envs = std::make_shared<std::vector<envs::BabyBenchEnv*>>(num_envs);
-  out.vec = std::make_unique<ThreadedVecEnv>(
-      num_envs,
-      [&](int i) {
-        auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
-        if (out.log) env->attach_log(out.log, i);
-        if (out.log && continue_log >= 0) env->skip_next_record();
-        (*envs)[i] = env.get();
-        return wrap ? wrap(std::move(env)) : std::unique_ptr<envs::Env>(std::move(env));
-      },
-      threads);
-  if (out.log) out.vec->set_after_step([log = out.log] { log->commit(); });
+  auto make = [&](int i) {
+    auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
+    if (out.log) env->attach_log(out.log, i);
+    if (out.log && continue_log >= 0) env->skip_next_record();
+    (*envs)[i] = env.get();
+    return wrap ? wrap(std::move(env)) : std::unique_ptr<envs::Env>(std::move(env));
+  };
+  std::function<void()> commit;
+  if (out.log) commit = [log = out.log] { log->commit(); };
+  // Async: the envs built here, in env order; its after-step call follows every batch.
+  if (async_batch > 0) {
+    std::vector<std::unique_ptr<envs::Env>> list;
+    for (int i = 0; i < num_envs; ++i) list.push_back(make(i));
+    auto vec = std::make_unique<AsyncVecEnv>(std::move(list), async_batch, threads);
+    vec->set_after_step(commit);
+    out.vec = std::move(vec);
+  } else {
+    auto vec = std::make_unique<ThreadedVecEnv>(num_envs, make, threads);
+    vec->set_after_step(commit);
+    out.vec = std::move(vec);
+  }
   out.end_episodes = [envs] {
     for (envs::BabyBenchEnv* env : *envs) env->end_episode();
   };
@@ -76,13 +90,16 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
                                                               int threads, bool training,
                                                               std::uint64_t seed, long continue_log,
                                                               const EnvWrapper& wrap) {
-  return make_vector(config, num_envs, threads, training, seed, continue_log, wrap).vec;
+  // Without async_batch the vector is a ThreadedVecEnv.
+  return std::unique_ptr<learn::ThreadedVecEnv>(static_cast<learn::ThreadedVecEnv*>(
+      make_vector(config, num_envs, threads, training, seed, continue_log, wrap, 0).vec.release()));
 }
 
 TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
                                        std::uint64_t seed, long continue_log,
-                                       const EnvWrapper& wrap) {
-  return make_vector(config, num_envs, threads, /*training=*/true, seed, continue_log, wrap);
+                                       const EnvWrapper& wrap, int async_batch) {
+  return make_vector(config, num_envs, threads, /*training=*/true, seed, continue_log, wrap,
+                     async_batch);
 }
 
 }  // namespace cradle::train

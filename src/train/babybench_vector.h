@@ -28,7 +28,8 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
 
 // A training vector and its training log, for the run's bookkeeping without knowing the family.
 struct TrainingVector {
-  std::unique_ptr<learn::ThreadedVecEnv> vec;
+  // A ThreadedVecEnv (lock-step), or an AsyncVecEnv when built with async_batch > 0.
+  std::unique_ptr<learn::VecEnv> vec;
   std::shared_ptr<envs::TrainingLog> log;  // shared by every env
   int geom_count = 0;                      // the model's geoms (the log's geom ids are below)
   // Records every env's current episode now, cut short (a checkpoint is an episode boundary).
@@ -37,9 +38,10 @@ struct TrainingVector {
 
 // make_babybench_vec_env with training = true. continue_log >= 0 (a resumed run): the log holding
 // that many entries is continued and every env's first reset records nothing (the episode before
-// it was never this run's).
+// it was never this run's). async_batch > 0: an AsyncVecEnv returning batches of that many envs
+// (the same env seeds), whose log commits after every batch (env order within a commit).
 TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
                                        std::uint64_t seed, long continue_log = -1,
-                                       const EnvWrapper& wrap = nullptr);
+                                       const EnvWrapper& wrap = nullptr, int async_batch = 0);
 
 }  // namespace cradle::train

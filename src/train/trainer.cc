@@ -8,6 +8,7 @@
 #include <iostream>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -190,6 +191,19 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (sync && algorithm != "ppo" && algorithm != "a2c" && algorithm != "sac") {
     throw UserError("--distributed trains ppo, a2c or sac, not " + algorithm);
   }
+  // Async collection is the on-policy collector's (docs/async.md).
+  if (options.async_batch != 0) {
+    if (options.async_batch < 1 || options.async_batch >= options.envs) {
+      throw UserError("--async-batch " + std::to_string(options.async_batch) +
+                      " must be between 1 and --envs - 1 (" + std::to_string(options.envs - 1) +
+                      "): a batch is part of the envs");
+    }
+    if (algorithm != "ppo" && algorithm != "a2c") {
+      throw UserError("--async-batch is for ppo and a2c (their rollout collector), not " +
+                      algorithm);
+    }
+    if (sync) throw UserError("--async-batch is not available with --distributed");
+  }
   if (sync) {
     std::string hp_text;
     for (const auto& [name, value] : hyperparameters) hp_text += name + "=" + value + ";";
@@ -256,10 +270,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (made) throw UserError("cannot create '" + (dir / "logs").string() + "': " + made.message());
   }
   TrainingVector training =
-      sample ? make_sample_training(options.env, options.envs, options.threads, options.seed, wrap)
-             : make_babybench_training(env_config, options.envs, options.threads,
-                                       options.seed + rank, kept_episodes, wrap);
-  std::unique_ptr<ThreadedVecEnv>& vec = training.vec;
+      sample
+          ? make_sample_training(options.env, options.envs, options.threads, options.seed, wrap,
+                                 options.async_batch)
+          : make_babybench_training(env_config, options.envs, options.threads, options.seed + rank,
+                                    kept_episodes, wrap, options.async_batch);
+  std::unique_ptr<VecEnv>& vec = training.vec;
   for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
     vec->env(i).set_reset_options({{"randomize_start", 1}});
   }
@@ -269,10 +285,11 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     reward = intrinsic::parse_intrinsic(options.intrinsic);
     reward->bind(*vec);
     // Every learn() resets the vector: no transition spans that reset.
-    vec->set_after_reset([&reward, &vec] { reward->reset(*vec); });
+    set_after_reset(*vec, [&reward, &vec] { reward->reset(*vec); });
   }
 
-  // Behaviour score of the episodes that end, seen at the step that ends them.
+  // Behaviour score of the episodes that end, seen at the step that ends them (async: the batch,
+  // whose slot i is env env_id(i)).
   double score_sum = 0;
   int score_count = 0;
   LearnerOptions lo{.seed = options.seed + rank, .hyperparameters = hyperparameters};

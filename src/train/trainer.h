@@ -29,6 +29,9 @@ struct TrainOptions {
   long steps = 100000;                          // env steps in total (counting a resumed run)
   int envs = 2;
   int threads = 0;  // 0: one per env, at most the cores
+  // > 0: PPO and A2C collect through an AsyncVecEnv (`threads` workers) in batches of the first
+  // async_batch envs to finish (1 <= async_batch < envs; docs/async.md); 0: lock-step.
+  int async_batch = 0;
   // LibTorch threads for gradient updates (LearnerOptions): 0: every core for image policies,
   // one for vector policies.
   int update_threads = 0;

@@ -125,3 +125,28 @@ def test_evaluate_with_python_policy(make_config):
     with pytest.raises(FileNotFoundError):
         cradle.evaluate(config, episodes=1, duration=5, render=False,
                         policy=config["save_dir"] + "/missing.ckpt", quiet=True)
+
+
+def test_train_with_async_batches(make_config):
+    # PPO collecting through the async vector (batches of 2 of 3 envs), a Python term beside a
+    # named one; each env fills 128 rows: its first reset's 0-step entry, two 50-step episodes
+    # (each with its autoreset row) and a 26-step one cut short by the final checkpoint.
+    config = make_config("selftouch", max_episode_steps=50)
+    calls = {"n": 0}
+
+    def touch_fraction(obs):
+        calls["n"] += 1
+        return float(np.mean(obs["touch"] > 1e-6))
+
+    result = cradle.train(
+        config, algo="ppo", intrinsic=[touch_fraction, "episode_coverage"], steps=384, envs=3,
+        threads=2, async_batch=2, seed=1,
+        hyperparameters={"n_steps": 64, "batch_size": 96, "n_epochs": 1}, eval_episodes=0,
+        progress_bar=False,
+    )
+    assert result["steps"] == 384
+    assert calls["n"] == 384  # once per env step
+    log = cradle.load_training_log(config["save_dir"])
+    assert sorted(e["steps"] for e in log) == [0] * 3 + [26] * 3 + [50] * 6
+    with pytest.raises(ValueError, match="--async-batch 3 must be between 1 and --envs - 1"):
+        cradle.train(config, steps=64, envs=3, async_batch=3, progress_bar=False)

@@ -50,11 +50,11 @@ void BodyPartNovelty::bind(const VecEnv& env) {
   now_.assign(onsets_ ? 2 : 0, {});
 }
 
-void BodyPartNovelty::start_episode(int i) {
-  seen_[i] = {0, 0};
+void BodyPartNovelty::start_episode(int id) {
+  seen_[id] = {0, 0};
   if (!onsets_) return;
   for (int h = 0; h < 2; ++h) {
-    std::fill(in_contact_[2 * i + h].begin(), in_contact_[2 * i + h].end(), 0);
+    std::fill(in_contact_[2 * id + h].begin(), in_contact_[2 * id + h].end(), 0);
   }
 }
 
@@ -62,17 +62,17 @@ void BodyPartNovelty::reset(const VecEnv& env) {
   if (static_cast<int>(seen_.size()) != env.num_envs()) bind(env);
   events_.clear();
   for (int i = 0; i < env.num_envs(); ++i) {
-    start_episode(i);
-    if (onsets_) collect_onsets(env, i);
+    start_episode(env.env_id(i));
+    if (onsets_) collect_onsets(env, i, env.env_id(i));
   }
   events_.clear();  // contacts present at the start are no onsets
   starts_.assign(env.num_envs(), false);
 }
 
-void BodyPartNovelty::collect_onsets(const VecEnv& env, int i) {
+void BodyPartNovelty::collect_onsets(const VecEnv& env, int i, int id) {
   const envs::Info& info = env.info(i);
   for (int h = 0; h < 2; ++h) {
-    std::vector<std::uint8_t>& before = in_contact_[2 * i + h];
+    std::vector<std::uint8_t>& before = in_contact_[2 * id + h];
     std::vector<std::uint8_t>& now = now_[h];
     std::fill(now.begin(), now.end(), 0);
     for (int g : info.list(contacts_slot_[h])) {
@@ -91,23 +91,24 @@ void BodyPartNovelty::collect_onsets(const VecEnv& env, int i) {
 
 void BodyPartNovelty::compute(const VecEnv& env, std::span<const double>,
                               std::span<double> rewards) {
-  if (static_cast<int>(seen_.size()) != env.num_envs()) bind(env);
+  if (seen_.empty()) bind(env);
   events_.clear();
   event_env_.clear();
   for (int i = 0; i < env.num_envs(); ++i) {
+    const int id = env.env_id(i);
     const size_t before = events_.size();
-    if (starts_[i]) start_episode(i);
+    if (starts_[id]) start_episode(id);
     if (onsets_) {
-      collect_onsets(env, i);
-      if (starts_[i]) events_.resize(before);  // a new episode's first contacts are no onsets
+      collect_onsets(env, i, id);
+      if (starts_[id]) events_.resize(before);  // a new episode's first contacts are no onsets
     }
     const envs::Info& info = env.info(i);
     for (int h = 0; h < 2; ++h) {
       if (touches_slot_[h] < 0) continue;
       const std::span<const int> list = info.list(touches_slot_[h]);
-      if (list.size() < seen_[i][h]) seen_[i][h] = 0;  // reset behind our back
-      for (size_t k = seen_[i][h]; k < list.size(); ++k) events_.push_back({h, list[k], false});
-      seen_[i][h] = list.size();
+      if (list.size() < seen_[id][h]) seen_[id][h] = 0;  // reset behind our back
+      for (size_t k = seen_[id][h]; k < list.size(); ++k) events_.push_back({h, list[k], false});
+      seen_[id][h] = list.size();
     }
     event_env_.resize(events_.size(), i);
   }

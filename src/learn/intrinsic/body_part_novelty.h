@@ -72,26 +72,28 @@ class BodyPartNovelty final : public IntrinsicReward {
   static long count(const std::vector<long>& counts, int geom) {
     return geom >= 0 && geom < static_cast<int>(counts.size()) ? counts[geom] : 0;
   }
-  void start_episode(int i);
-  // Appends env i's contact onsets of this step to events_ and remembers its contacts.
-  void collect_onsets(const VecEnv& env, int i);
+  void start_episode(int id);
+  // Appends the contact onsets of slot i (env id `id`) in this step to events_ and remembers its
+  // contacts.
+  void collect_onsets(const VecEnv& env, int i, int id);
 
   Options options_;
   // Counts over training (index: geom id; grown on demand).
   std::array<std::vector<long>, 2> first_, onset_;
   std::array<int, 2> distinct_{0, 0};
 
-  // Per env: entries of the Info touch lists already rewarded, and (for onsets) which geoms each
-  // hand touched in the previous step (indexed env * 2 + hand, then geom id; grown on demand).
+  // Per env id: entries of the Info touch lists already rewarded, and (for onsets) which geoms
+  // each hand touched in the previous step (indexed id * 2 + hand, then geom id; grown on
+  // demand).
   std::vector<std::array<size_t, 2>> seen_;
   std::vector<std::vector<std::uint8_t>> in_contact_, now_;
   detail::EpisodeStarts starts_;
 
   // Info slots of the env's touch and contact lists per hand (-1: not published).
   std::array<int, 2> touches_slot_{-1, -1}, contacts_slot_{-1, -1};
-  bool onsets_ = false;        // the env publishes its contacts and onset_weight > 0
-  std::vector<Event> events_;  // scratch: this step's events
-  std::vector<int> event_env_;
+  bool onsets_ = false;         // the env publishes its contacts and onset_weight > 0
+  std::vector<Event> events_;   // scratch: this step's events
+  std::vector<int> event_env_;  // scratch: the slot of each event
 };
 
 }  // namespace cradle::learn::intrinsic

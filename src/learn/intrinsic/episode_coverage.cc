@@ -25,18 +25,19 @@ void EpisodeCoverage::reset(const VecEnv& env) {
 
 void EpisodeCoverage::compute(const VecEnv& env, std::span<const double>,
                               std::span<double> rewards) {
-  if (static_cast<int>(seen_.size()) != env.num_envs()) bind(env);
+  if (seen_.empty()) bind(env);
   for (int i = 0; i < env.num_envs(); ++i) {
+    const int id = env.env_id(i);
     // An autoreset step starts a new episode: its lists start empty again.
-    if (starts_[i]) seen_[i] = {0, 0};
+    if (starts_[id]) seen_[id] = {0, 0};
     const envs::Info& info = env.info(i);
     std::size_t found = 0;
     for (int h = 0; h < 2; ++h) {
       if (slots_[h] < 0) continue;
       const std::size_t size = info.list(slots_[h]).size();
-      if (size < seen_[i][h]) seen_[i][h] = 0;  // the env reset its lists behind our back
-      found += size - seen_[i][h];
-      seen_[i][h] = size;
+      if (size < seen_[id][h]) seen_[id][h] = 0;  // the env reset its lists behind our back
+      found += size - seen_[id][h];
+      seen_[id][h] = size;
     }
     rewards[i] += scale() * static_cast<double>(found) / kScoreGeoms;
   }

@@ -62,17 +62,23 @@ void LearnedReward::bind(const VecEnv& env) {
 
 void LearnedReward::observe(const VecEnv& env, std::vector<float>& rows) {
   const int d = features_.size();
+  const std::span<float> used =
+      std::span<float>(rows).first(static_cast<size_t>(env.num_envs()) * d);
   for (int i = 0; i < env.num_envs(); ++i) {
-    features_.extract(env, i, std::span<float>(rows).subspan(static_cast<size_t>(i) * d, d));
+    features_.extract(env, i, used.subspan(static_cast<size_t>(i) * d, d));
   }
-  norm_.update(rows);
-  norm_.apply(rows);
+  norm_.update(used);
+  norm_.apply(used);
 }
 
 void LearnedReward::reset(const VecEnv& env) {
   if (!bound_) bind(env);
-  observe(env, prev_);
-  starts_.assign(env.num_envs(), false);
+  observe(env, next_);
+  const size_t d = features_.size();
+  for (int i = 0; i < env.num_envs(); ++i) {
+    std::copy_n(&next_[i * d], d, &prev_[env.env_id(i) * d]);
+  }
+  starts_.assign(starts_.size(), false);
 }
 
 void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
@@ -84,9 +90,9 @@ void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
   // Rows that are samples: every env for state rewards, transitions only for the others.
   std::vector<int> rows;
   for (int i = 0; i < n; ++i) {
-    if (!transitions() || !starts_[i]) rows.push_back(i);
+    if (!transitions() || !starts_[env.env_id(i)]) rows.push_back(i);
+    last_raw_[env.env_id(i)] = 0;
   }
-  std::fill(last_raw_.begin(), last_raw_.end(), 0);
   if (!rows.empty()) {
     const long v = static_cast<long>(rows.size());
     torch::Tensor next = torch::empty({v, d}), s, a;
@@ -98,7 +104,7 @@ void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
       const size_t i = rows[r];
       std::copy_n(&next_[i * d], d, next.data_ptr<float>() + r * d);
       if (transitions()) {
-        std::copy_n(&prev_[i * d], d, s.data_ptr<float>() + r * d);
+        std::copy_n(&prev_[env.env_id(i) * d], d, s.data_ptr<float>() + r * d);
         float* ap = a.data_ptr<float>() + r * na;
         for (int k = 0; k < na; ++k) ap[k] = static_cast<float>(actions[i * na + k]);
       }
@@ -111,7 +117,7 @@ void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
     const double* rp = raw.data_ptr<double>();
     for (long r = 0; r < v; ++r) reward_std_.update(rp[r]);
     for (long r = 0; r < v; ++r) {
-      last_raw_[rows[r]] = rp[r];
+      last_raw_[env.env_id(rows[r])] = rp[r];
       rewards[rows[r]] += scale() * reward_std_.scale(rp[r]);
     }
     // The samples join the ring.
@@ -119,7 +125,7 @@ void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
       const size_t i = rows[r], slot = head_;
       std::copy_n(&next_[i * d], d, &buf_next_[slot * d]);
       if (transitions()) {
-        std::copy_n(&prev_[i * d], d, &buf_s_[slot * d]);
+        std::copy_n(&prev_[env.env_id(i) * d], d, &buf_s_[slot * d]);
         for (int k = 0; k < na; ++k)
           buf_a_[slot * na + k] = static_cast<float>(actions[i * na + k]);
       }
@@ -127,7 +133,11 @@ void LearnedReward::compute(const VecEnv& env, std::span<const double> actions,
       filled_ = std::min(filled_ + 1, options_.buffer);
     }
   }
-  prev_.swap(next_);
+  // This step's features are each env's previous ones at its next step.
+  for (int i = 0; i < n; ++i) {
+    std::copy_n(&next_[static_cast<size_t>(i) * d], d,
+                &prev_[static_cast<size_t>(env.env_id(i)) * d]);
+  }
   starts_.record_flags(env);
 }
 

@@ -66,7 +66,7 @@ class LearnedReward : public IntrinsicReward {
   void load(const std::filesystem::path& dir) override;
 
   int feature_size() const { return features_.size(); }
-  // Raw (unnormalised) rewards of the last compute(), per env.
+  // Raw (unnormalised) rewards of each env's last compute(), by env id.
   std::span<const double> last_raw() const { return last_raw_; }
   // Samples waiting for the next update().
   int buffered() const { return filled_; }
@@ -105,7 +105,8 @@ class LearnedReward : public IntrinsicReward {
   bool bound_ = false;
   at::Generator gen_;
   std::mt19937_64 draw_;
-  // Per env: the previous normalised features (num_envs x features) and episode starts.
+  // Per env id: the previous normalised features (num_envs x features) and episode starts;
+  // next_: this call's features, per slot.
   std::vector<float> prev_, next_;
   detail::EpisodeStarts starts_;
   std::vector<double> last_raw_;

@@ -20,22 +20,25 @@ void RegardCount::bind(const VecEnv& env) {
 void RegardCount::reset(const VecEnv& env) {
   if (static_cast<int>(previous_.size()) != env.num_envs()) bind(env);
   for (int i = 0; i < env.num_envs(); ++i) {
-    for (int eye = 0; eye < 2; ++eye) previous_[i][eye] = env.info(i).number(slots_[eye]);
+    for (int eye = 0; eye < 2; ++eye) {
+      previous_[env.env_id(i)][eye] = env.info(i).number(slots_[eye]);
+    }
   }
   starts_.assign(env.num_envs(), false);
 }
 
 void RegardCount::compute(const VecEnv& env, std::span<const double>, std::span<double> rewards) {
-  if (static_cast<int>(previous_.size()) != env.num_envs()) bind(env);
+  if (previous_.empty()) bind(env);
   for (int i = 0; i < env.num_envs(); ++i) {
+    const int id = env.env_id(i);
     const envs::Info& info = env.info(i);
     double in_view = 0;
     for (int eye = 0; eye < 2; ++eye) {
       const double now = info.number(slots_[eye]);
       // An autoreset step starts a new episode (its counters restart from the reset's values):
       // no transition, no reward.
-      if (!starts_[i] && now >= previous_[i][eye]) in_view += now - previous_[i][eye];
-      previous_[i][eye] = now;
+      if (!starts_[id] && now >= previous_[id][eye]) in_view += now - previous_[id][eye];
+      previous_[id][eye] = now;
     }
     rewards[i] += scale() * in_view / 2;
   }

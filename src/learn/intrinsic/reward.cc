@@ -81,7 +81,8 @@ void FunctionReward::compute(const VecEnv& env, std::span<const double> actions,
   const int n = env.num_envs();
   const size_t dim = n > 0 ? actions.size() / n : 0;
   for (int i = 0; i < n; ++i) {
-    rewards[i] += scale() * fn_(i, env.observation(i), actions.subspan(i * dim, dim), env.info(i));
+    rewards[i] += scale() * fn_(env.env_id(i), env.observation(i), actions.subspan(i * dim, dim),
+                                env.info(i));
   }
 }
 
@@ -173,8 +174,7 @@ int key_index(const VecEnv& env, std::string_view key) {
 void EpisodeStarts::record_flags(const VecEnv& env) {
   const auto terminated = env.terminated();
   const auto truncated = env.truncated();
-  starts_.resize(env.num_envs());
-  for (int i = 0; i < env.num_envs(); ++i) starts_[i] = terminated[i] || truncated[i];
+  for (int i = 0; i < env.num_envs(); ++i) starts_[env.env_id(i)] = terminated[i] || truncated[i];
 }
 
 }  // namespace detail

@@ -11,9 +11,11 @@
 //   every rollout: r->update();   // learned rewards train on what compute() saw
 //   checkpoints: r->save(dir) / r->load(dir)
 //
-// compute() must see every step of the vector, in order: stateful rewards use the episode flags of
-// the previous call to recognise next-step autoresets (VecEnv's Gymnasium 1.x convention: an env
-// whose episode ended in call t is reset by call t+1, whose observation is then no transition).
+// compute() must see every step of every env, in order: stateful rewards use the episode flags of
+// an env's previous step to recognise next-step autoresets (VecEnv's Gymnasium 1.x convention: an
+// env whose episode ended in step t is reset by step t+1, whose observation is then no
+// transition). The vector given to compute() may be part of the bound one (an async vector's
+// batch, learn::BatchView): slot i is env env.env_id(i), and per-env state is indexed by that id.
 #pragma once
 
 #include <cstdint>
@@ -30,8 +32,9 @@
 
 namespace cradle::learn::intrinsic {
 
-// One intrinsic reward over a vector of envs. Rewards that keep state keep it per env (indexed
-// like the vector) and, for counts and learned models, over the whole training run.
+// One intrinsic reward over a vector of envs. Rewards that keep state keep it per env (indexed by
+// env id, sized in bind() from the whole vector) and, for counts and learned models, over the
+// whole training run.
 class IntrinsicReward {
  public:
   explicit IntrinsicReward(double scale) : scale_(scale) {}
@@ -49,8 +52,9 @@ class IntrinsicReward {
   virtual void bind(const VecEnv& /*env*/) {}
   // Called after VecEnv::reset: every env starts a new episode, no transition spans the reset.
   virtual void reset(const VecEnv& /*env*/) {}
-  // Called after each VecEnv::step with that step's actions (num_envs x action dim, row-major):
-  // adds scale() x this reward of env i to rewards[i] (rewards has num_envs entries).
+  // Called after each VecEnv::step (or an async batch) with that step's actions (num_envs x
+  // action dim, row-major): adds scale() x this reward of slot i to rewards[i] (rewards has
+  // num_envs entries).
   virtual void compute(const VecEnv& env, std::span<const double> actions,
                        std::span<double> rewards) = 0;
   // Learned rewards (rnd, icm, disagreement) train on the samples collected by compute() since the
@@ -73,8 +77,8 @@ std::vector<std::string> intrinsic_names();
 // listing the known names) for an unknown name.
 std::unique_ptr<IntrinsicReward> make_intrinsic(std::string_view name, double scale = 1.0);
 
-// Adapter for a callable (e.g. a Python function): reward of env i =
-// scale x fn(i, observation(i), action of env i, info(i)).
+// Adapter for a callable (e.g. a Python function): reward of slot i =
+// scale x fn(env_id(i), observation(i), action of slot i, info(i)).
 class FunctionReward final : public IntrinsicReward {
  public:
   using Function = std::function<double(int env, const envs::ObservationBuffers& observation,
@@ -127,15 +131,17 @@ std::unique_ptr<Composite> parse_intrinsic(std::string_view spec);
 namespace detail {
 // Index of an observation key in the vector's space, or -1.
 int key_index(const VecEnv& env, std::string_view key);
-// Per env: whether its observation in the current compute() starts an episode (VecEnv's
+// Per env id: whether its observation in the current compute() starts an episode (VecEnv's
 // next-step autoreset) or has no earlier observation known to the reward; either way it ends no
 // transition. Starts all true; a reward that records the observations at reset(vec) clears it.
 class EpisodeStarts {
  public:
   void assign(int num_envs, bool value) { starts_.assign(num_envs, value ? 1 : 0); }
-  // Call at the end of compute(): envs whose episode ended in this step are reset by the next.
+  // Call at the end of compute(): the envs of this call whose episode ended in this step are
+  // reset by their next one.
   void record_flags(const VecEnv& env);
-  bool operator[](int i) const { return starts_[i] != 0; }
+  bool operator[](int id) const { return starts_[id] != 0; }
+  int size() const { return static_cast<int>(starts_.size()); }
 
  private:
   std::vector<std::uint8_t> starts_;
