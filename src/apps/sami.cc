@@ -4,6 +4,8 @@
 // `bench` measures env steps/s against the bare mj_steps; `info` prints the spaces and the task
 // sets of every split; `train` / `evaluate` / `table` train a method, evaluate it on a split and
 // tabulate runs as the paper's Table 1/2.
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -23,6 +25,11 @@
 
 namespace cradle::apps {
 namespace {
+
+// The one piece of process state: set by SIGINT or SIGTERM so that `sami train` stops cleanly
+// with a checkpoint.
+std::atomic<bool> sami_interrupted{false};
+extern "C" void on_sami_interrupt(int) { sami_interrupted.store(true); }
 
 std::string eval_num(double v) {
   char buf[32];
@@ -139,12 +146,19 @@ void register_learners(CLI::App& cmd) {
   tr->callback([opts] {
     opts->train.hyperparameters = parse_hp(opts->hp);
     opts->train.out = opts->out;
+    std::signal(SIGINT, on_sami_interrupt);
+    std::signal(SIGTERM, on_sami_interrupt);
+    opts->train.stop = &sami_interrupted;
     const train::SamiTrainResult r = train::sami_train(opts->train);
     std::printf(
         "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "
         "last return %.3f\ncheckpoint: %s\n",
         r.run.string().c_str(), r.steps, r.updates, r.sps, r.gradient_steps_per_s, r.last_return,
         (r.run / "checkpoint.ckpt").string().c_str());
+    if (r.stopped) {
+      std::printf("stopped by a signal; continue with: cradle sami train --out %s --resume\n",
+                  r.run.string().c_str());
+    }
   });
 
   CLI::App* ev = cmd.add_subcommand("evaluate", "Evaluate a trained run on a split, per task cell");

@@ -309,7 +309,8 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     }
 
     // Progress row, bar and checkpoint.
-    const bool last = steps >= total;
+    const bool stopping = options.stop && options.stop->load() && steps < total;
+    const bool last = steps >= total || stopping;
     if (vector_step % report_every == 0 || last) {
       const Clock::time_point now = Clock::now();
       const double sps = (steps - report_steps_from) / std::max(seconds(report_start, now), 1e-9);
@@ -341,6 +342,10 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     if (steps - last_checkpoint >= checkpoint_every || last) {
       learner.save(checkpoint, steps);
       last_checkpoint = steps;
+    }
+    if (stopping) {
+      result.stopped = true;
+      break;
     }
   }
   if (options.progress_bar) std::fprintf(stderr, "\n");

@@ -6,6 +6,7 @@
 // after evaluation, eval_<split>.json / .csv and contexts_<split>.csv.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -32,6 +33,9 @@ struct SamiTrainOptions {
   long checkpoint_every = 100'000;  // env steps per training env between checkpoints
   long report_every = 0;            // vector steps between progress rows (0: one episode length)
   bool progress_bar = true;
+  // Set (e.g. by Ctrl-C) to stop after the current vector step with a checkpoint and a progress
+  // row, so that --resume continues from there.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct SamiTrainResult {
@@ -41,6 +45,7 @@ struct SamiTrainResult {
   double sps = 0;                   // env steps per second, whole run of this call
   double gradient_steps_per_s = 0;  // gradient steps per second of update time
   double last_return = 0;           // mean return of the episodes of the last report
+  bool stopped = false;             // ended by `stop` before the budget
 };
 SamiTrainResult sami_train(const SamiTrainOptions& options);
 

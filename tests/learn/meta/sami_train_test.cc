@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -95,6 +96,35 @@ TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
   EXPECT_EQ(j.at("method"), "SaCCM");
   EXPECT_EQ(j.at("cells").size(), 8u);
   EXPECT_THROW(sami_evaluate({.run = dir, .split = "hard"}), UserError);
+  std::filesystem::remove_all(dir);
+}
+
+// A stop request (Ctrl-C) ends the run after the current vector step with a checkpoint and a
+// progress row at that step; --resume continues from it to the budget.
+TEST(SamiTrain, StopWritesACheckpointThatResumes) {
+  const auto dir = scratch("stop");
+  std::atomic<bool> stop{true};
+  SamiTrainOptions o{.env = "PandaPush",
+                     .method = "CCM",
+                     .seed = 3,
+                     .steps_per_env = 100,
+                     .hyperparameters = tiny_hp(),
+                     .out = dir,
+                     .checkpoint_every = 1000,
+                     .report_every = 25,
+                     .progress_bar = false,
+                     .stop = &stop};
+  const SamiTrainResult stopped = sami_train(o);
+  EXPECT_TRUE(stopped.stopped);
+  EXPECT_EQ(stopped.steps, 6);  // one vector step of Panda's 6 training envs
+  EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.ckpt"));
+  EXPECT_EQ(lines(dir / "progress.csv"), 2);  // header + the row at the stop
+  stop = false;
+  o.resume = true;
+  const SamiTrainResult r = sami_train(o);
+  EXPECT_FALSE(r.stopped);
+  EXPECT_EQ(r.steps, 600);
+  EXPECT_EQ(lines(dir / "progress.csv"), 1 + 1 + 100 / 25);  // the stop's row kept, then 4 more
   std::filesystem::remove_all(dir);
 }
 
