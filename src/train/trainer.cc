@@ -250,17 +250,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   auto write_teacher_log = [&](bool dump) {
     if (!teacher_log) return;
     for (const teach::EpisodeRecord& e : curriculum->take_episodes())
-      teacher_log->write({{"kind", "train"},
-                          {"episode", e.episode},
-                          {"env_steps", e.env_steps},
-                          {"task", e.task},
-                          {"return", e.ret},
-                          {"length", e.length},
-                          {"success", e.success}});
+      teacher_log->write(teach::train_line(e));
     if (dump)
-      teacher_log->write({{"kind", "dump"},
-                          {"env_steps", curriculum->env_steps()},
-                          {"teacher", curriculum->teacher_dump()}});
+      teacher_log->write(teach::dump_line(curriculum->env_steps(), curriculum->teacher_dump()));
     teacher_log->flush();
   };
   // A resumed run's first resets end no episode of this run's log.
