@@ -4,7 +4,6 @@
 // `bench` measures env steps/s against the bare mj_steps; `info` prints the spaces and the task
 // sets of every split; `train` / `evaluate` / `table` train a method, evaluate it on a split and
 // tabulate runs as the paper's Table 1/2.
-#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "apps/interrupt.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/rng.h"
@@ -25,11 +25,6 @@
 
 namespace cradle::apps {
 namespace {
-
-// The one piece of process state: set by SIGINT or SIGTERM so that `sami train` stops cleanly
-// with a checkpoint.
-std::atomic<bool> sami_interrupted{false};
-extern "C" void on_sami_interrupt(int) { sami_interrupted.store(true); }
 
 std::string eval_num(double v) {
   char buf[32];
@@ -146,9 +141,7 @@ void register_learners(CLI::App& cmd) {
   tr->callback([opts] {
     opts->train.hyperparameters = parse_hp(opts->hp);
     opts->train.out = opts->out;
-    std::signal(SIGINT, on_sami_interrupt);
-    std::signal(SIGTERM, on_sami_interrupt);
-    opts->train.stop = &sami_interrupted;
+    opts->train.stop = stop_on({SIGINT, SIGTERM});
     const train::SamiTrainResult r = train::sami_train(opts->train);
     std::printf(
         "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "

@@ -1,7 +1,6 @@
 // `cradle train --config FILE --algo ppo --intrinsic NAME[,NAME...] --steps N --envs K --seed S
 // [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it. `--env NAME`
 // instead of --config trains a MIMo sample env (e.g. with --task-space and --teacher).
-#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -10,6 +9,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/interrupt.h"
 #include "core/config.h"
 #include "core/error.h"
 #include "dist/process_group.h"
@@ -17,14 +17,6 @@
 #include "train/trainer.h"
 
 namespace cradle::apps {
-namespace {
-
-// The one piece of process state: set by SIGINT so training stops cleanly with a checkpoint.
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted.store(true); }
-
-}  // namespace
-
 void register_train(CLI::App& app) {
   struct Options {
     std::string config;
@@ -123,9 +115,8 @@ void register_train(CLI::App& app) {
       }
       opts->train.hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
-    std::signal(SIGINT, on_interrupt);
-    if (opts->distributed) std::signal(SIGTERM, on_interrupt);  // srun and launch stop with it
-    opts->train.stop = &interrupted;
+    // srun and launch stop a distributed run's ranks with SIGTERM.
+    opts->train.stop = opts->distributed ? stop_on({SIGINT, SIGTERM}) : stop_on({SIGINT});
     std::unique_ptr<dist::ProcessGroup> group;
     if (opts->distributed) {
       group = std::make_unique<dist::ProcessGroup>(
@@ -145,7 +136,7 @@ void register_train(CLI::App& app) {
                   group->collectives(), group->collective_seconds());
     }
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
-                r.steps_per_second, interrupted ? " — interrupted" : "");
+                r.steps_per_second, opts->train.stop->load() ? " — interrupted" : "");
     if (group && group->rank() > 0) return;  // rank 0 reports the run's files
     std::printf("checkpoint: %s\n", r.checkpoint.c_str());
     if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
