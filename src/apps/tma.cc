@@ -8,6 +8,7 @@
 //   info   : observation / action sizes and masses of every embodiment in both envs (JSON).
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "apps/interrupt.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/rng.h"
@@ -382,12 +384,20 @@ void register_tma(CLI::App& app) {
                    {"out", o.out.string()},
                    {"resume", ro.resume}};
     o.commit = source_commit();
+    // Ctrl-C or a scheduler's SIGTERM ends the run at its next report instead of killing it.
+    o.stop = stop_on({SIGINT, SIGTERM});
     const train::StudentRunResult r = train::run_student(tma_student_env(ro), o);
     std::printf(
         "%s: %ld env steps, %ld episodes, %d evaluations, %.1f s, %.0f env steps/s, %.1f "
         "gradient steps/s, teacher %.2f%% of the time, %.0f%% mastered\n",
         o.out.string().c_str(), r.env_steps, r.episodes, r.evaluations, r.wall_s, r.env_steps_per_s,
         r.gradient_steps_per_s, 100 * r.teacher_s / std::max(r.wall_s, 1e-9), r.last_pct_mastered);
+    if (r.stopped) {
+      std::printf(
+          "stopped by a signal at %ld env steps; --resume continues from the checkpoint at %ld env "
+          "steps (the last evaluation): cradle tma run ... --out %s --resume\n",
+          r.env_steps, r.checkpoint_steps, o.out.string().c_str());
+    }
   });
 
   CLI::App* info = tma_cmd->add_subcommand("info", "Spaces and masses per embodiment (JSON)");

@@ -368,6 +368,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   const long first_steps = run_steps();
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   StudentRunResult result;
+  result.checkpoint_steps = first_steps;
   double train_return_sum = 0;
   long train_returns = 0;
   // SAC's update counter (per learner; a resumed one counts from its first report).
@@ -449,6 +450,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     for (const char* name : kLogs) saved["sizes"][name] = fs::file_size(dir / name);
     write_atomically(state_file, saved.dump(2) + "\n");
     result.last_pct_mastered = pct;
+    result.checkpoint_steps = steps;
     ++result.evaluations;
     ++evaluation;
   };
@@ -504,6 +506,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   teacher_log.flush();
 
   result.env_steps = run_steps();
+  result.stopped = stopped() && result.env_steps < o.total_steps;
   result.episodes = controller->episodes();
   result.wall_s = elapsed();
   result.env_steps_per_s = (result.env_steps - first_steps) / std::max(result.wall_s, 1e-9);
@@ -521,7 +524,9 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
       {"teacher_s", result.teacher_s},
       {"teacher_share", result.teacher_s / std::max(result.wall_s, 1e-9)},
       {"eval_s", result.eval_s},
-      {"pct_mastered", result.last_pct_mastered}};
+      {"pct_mastered", result.last_pct_mastered},
+      {"stopped", result.stopped},
+      {"checkpoint_env_steps", result.checkpoint_steps}};
   if (std::isnan(result.gradient_steps)) {
     summary["gradient_steps"] = nullptr;
     summary["gradient_steps_per_s"] = nullptr;

@@ -67,6 +67,8 @@ struct StudentRunResult {
   double teacher_s = 0;  // time inside the teacher controller
   double eval_s = 0;     // time evaluating
   double last_pct_mastered = 0;
+  bool stopped = false;       // ended early by `stop`
+  long checkpoint_steps = 0;  // env steps of the checkpoint that --resume continues from
 };
 
 // The reference presets (spec tma_sami.md §4.1, §4.2) as learner hyperparameters; total_steps caps

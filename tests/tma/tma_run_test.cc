@@ -229,6 +229,32 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   EXPECT_EQ(read_lines(dir / "progress.csv").size(), 5u);
 }
 
+TEST(TmaRun, InterruptStopsAtAReportAndResumes) {
+  const fs::path dir = fresh("cradle_tma_run_stop");
+  const std::string args = kSac + "--teacher Random --out " + dir.string();
+  // A run of a million steps, interrupted once it has begun (its progress.csv exists): it ends
+  // by itself, exit 0 (a run that ignored the signal would meet the 5-minute timeout: 124).
+  const std::string progress_csv = (dir / "progress.csv").string();
+  RunResult r = cradle::test::run(
+      "timeout 300 sh -c '" + std::string(CRADLE_BINARY) + " " + args +
+      " --nb_env_steps 1 & pid=$!; " + "while kill -0 $pid 2>/dev/null && [ ! -s " + progress_csv +
+      " ]; do sleep 0.1; done; " + "sleep 1; kill -INT $pid; wait $pid' 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("stopped by a signal at "), std::string::npos) << r.out;
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
+  EXPECT_EQ(summary["stopped"], true);
+  const long checkpoint = summary["checkpoint_env_steps"].get<long>();
+  EXPECT_EQ(checkpoint % 1000, 0);
+  EXPECT_LT(checkpoint, 1'000'000);
+  // --resume goes on from the last evaluation's checkpoint to one evaluation more.
+  const std::string target = std::to_string((checkpoint + 1000) / 1e6);
+  r = run_cradle(args + " --nb_env_steps " + target + " --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::vector<std::string> progress = read_lines(dir / "progress.csv");
+  EXPECT_EQ(cells(progress.back())[1], std::to_string(checkpoint + 1000));
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "summary.json"))["stopped"], false);
+}
+
 TEST(TmaRun, BadInputIsAOneLineError) {
   const fs::path dir = fresh("cradle_tma_run_bad");
   for (const char* bad :
