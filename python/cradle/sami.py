@@ -106,8 +106,11 @@ def table(runs, out=""):
 
 
 def plot_contexts(csv, png, title=None):
-    """Draws a contexts_<split>.csv (written by evaluate) as two scatter plots of its 2-D PCA:
-    coloured by task cell and by the step's skill label. Needs matplotlib."""
+    """Draws a contexts_<split>.csv (written by evaluate) as two scatter plots of its 2-D PCA.
+
+    Panda push: coloured by task cell (friction, mass) and by the episode's skill (push, roll,
+    pick-and-place). Locomotion, which has no skill labels: by the crippled joints each episode
+    drew and by its mass factor. Needs matplotlib."""
     import csv as csv_module
 
     import matplotlib
@@ -120,16 +123,21 @@ def plot_contexts(csv, png, title=None):
         raise ValueError(f"{csv}: no contexts")
     x = np.array([float(r["pc1"]) for r in rows])
     y = np.array([float(r["pc2"]) for r in rows])
+    has_skills = any(r["episode_skill"] != "none" for r in rows)
+    panels = (("cell", "task"), ("episode_skill", "skill")) if has_skills else (
+        ("crippled", "crippled joints"), ("mass", "mass factor"))
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    for ax, key, name in ((axes[0], "cell", "task"), (axes[1], "episode_skill", "skill")):
+    for ax, (key, name) in zip(axes, panels):
         labels = sorted({r[key] for r in rows})
+        colours = plt.cm.tab20 if len(labels) > 10 else plt.cm.tab10
         for i, label in enumerate(labels):
             mask = np.array([r[key] == label for r in rows])
-            ax.scatter(x[mask], y[mask], s=4, alpha=0.6, label=label, color=plt.cm.tab10(i % 10))
+            ax.scatter(x[mask], y[mask], s=4, alpha=0.6, label=label,
+                       color=colours(i % colours.N))
         ax.set_title(f"contexts by {name}")
         ax.set_xlabel("PC 1")
         ax.set_ylabel("PC 2")
-        ax.legend(fontsize=6, markerscale=3)
+        ax.legend(fontsize=6, markerscale=3, ncol=2 if len(labels) > 10 else 1)
     if title:
         fig.suptitle(title)
     fig.tight_layout()

@@ -376,7 +376,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   result.csv = options.run / (stem + ".csv");
   result.contexts = options.run / ("contexts_" + options.split + ".csv");
   std::ofstream contexts(result.contexts);
-  contexts << "task_set,cell,episode,step,skill,episode_skill";
+  contexts << "task_set,cell,episode,step,mass,damping,crippled,skill,episode_skill";
   for (int k = 0; k < config.context_size; ++k) contexts << ",c" << k;
   contexts << ",pc1,pc2\n";
   std::vector<std::string> context_rows, episode_rows;
@@ -404,6 +404,14 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
     std::vector<double> episode_returns;
     for (int e = 0; e < options.episodes; ++e) {
       env->reset();
+      // The parameters this episode drew (the task, within its task set): mass, damping, the
+      // crippled joints ("0+4"; "none").
+      const sami::Info& drawn = env->info();
+      std::string crippled;
+      for (int joint : drawn.crippled)
+        crippled += (crippled.empty() ? "" : "+") + std::to_string(joint);
+      const std::string episode_task = number(drawn.mass) + "," + number(drawn.damping) + "," +
+                                       (crippled.empty() ? "none" : crippled);
       ContextSac::Streams streams = learner.streams(1);
       double ret = 0;
       sami::StepResult r;
@@ -420,7 +428,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
         ret += r.reward;
         if (step % context_every == 0) {
           episode_rows.push_back(std::to_string(s) + ",\"" + cell.name + "\"," + std::to_string(e) +
-                                 "," + std::to_string(step) + "," +
+                                 "," + std::to_string(step) + "," + episode_task + "," +
                                  std::string(sami::skill_name(env->info().skill)));
           const float* cp = c.data_ptr<float>();
           context_values.insert(context_values.end(), cp, cp + config.context_size);

@@ -99,6 +99,50 @@ TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
   std::filesystem::remove_all(dir);
 }
 
+// The context rows of a crippled env name the parameters each episode drew: a mass of its task
+// set, damping 1 and one front and one back joint (the extreme split of CrippleHalfCheetah).
+TEST(SamiEvaluate, ContextRowsNameTheDrawnTask) {
+  const auto dir = scratch("contexts");
+  auto hp = tiny_hp();
+  hp["learning_starts"] = "1000";
+  sami_train({.env = "CrippleHalfCheetah",
+              .method = "CCM",
+              .seed = 4,
+              .steps_per_env = 10,
+              .hyperparameters = hp,
+              .out = dir,
+              .progress_bar = false});
+  const SamiEvalResult e = sami_evaluate({.run = dir, .split = "extreme", .episodes = 2});
+  std::ifstream in(e.contexts);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(
+      line.rfind("task_set,cell,episode,step,mass,damping,crippled,skill,episode_skill,c0,", 0), 0u)
+      << line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    // The fields after the quoted cell name: episode, step, mass, damping, crippled, ...
+    std::stringstream fields(line.substr(line.rfind('"') + 2));
+    std::string episode, step, mass, damping, crippled;
+    std::getline(fields, episode, ',');
+    std::getline(fields, step, ',');
+    std::getline(fields, mass, ',');
+    std::getline(fields, damping, ',');
+    std::getline(fields, crippled, ',');
+    EXPECT_EQ(std::stoi(step) % 10, 0);  // every 10th step on locomotion
+    const double m = std::stod(mass);
+    EXPECT_TRUE(m == 0.2 || m == 0.3 || m == 1.7 || m == 1.8) << line;
+    EXPECT_EQ(damping, "1");
+    ASSERT_EQ(crippled.size(), 3u) << line;  // "back+front", e.g. "1+4"
+    EXPECT_LE(crippled[0], '2');
+    EXPECT_EQ(crippled[1], '+');
+    EXPECT_GE(crippled[2], '3');
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2 * 2 * 1000 / 10);  // 2 task sets x 2 episodes x 100 rows
+  std::filesystem::remove_all(dir);
+}
+
 // A stop request (Ctrl-C) ends the run after the current vector step with a checkpoint and a
 // progress row at that step; --resume continues from it to the budget.
 TEST(SamiTrain, StopWritesACheckpointThatResumes) {
