@@ -30,6 +30,17 @@ inline std::filesystem::path fresh_dir(const std::string& tag) {
   return dir;
 }
 
+// A quick self-touch config (crib, no vision, `episode_steps`-step episodes, then `extra` YAML
+// lines) in dir/config.yml whose run goes to dir/run; returns the config's path.
+inline std::string self_touch_config(const std::filesystem::path& dir, int episode_steps,
+                                     const std::string& extra = "") {
+  const std::filesystem::path file = dir / "config.yml";
+  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
+                      << "\nvision_active: False\nmax_episode_steps: " << episode_steps << "\n"
+                      << extra;
+  return file.string();
+}
+
 // The lines of a text file, without their '\n' (none when the file cannot be read).
 inline std::vector<std::string> read_lines(const std::filesystem::path& file) {
   std::ifstream in(file);

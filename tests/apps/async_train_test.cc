@@ -25,10 +25,7 @@ using cradle::test::RunResult;
 
 // A quick self-touch config (no vision, 10-step episodes) writing to dir/run.
 std::string training_config(const fs::path& dir) {
-  const fs::path file = dir / "config.yml";
-  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-                      << "\nvision_active: False\nmax_episode_steps: 10\nsave_logs_every: 1000\n";
-  return file.string();
+  return cradle::test::self_touch_config(dir, 10, "save_logs_every: 1000\n");
 }
 
 // 3 envs, 16-step rollouts (48 env steps), a checkpoint every 96.

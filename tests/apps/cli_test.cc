@@ -31,10 +31,7 @@ int lines(const std::string& s) {
 // A quick training config in dir/config.yml (self-touch, no vision, 100-step episodes) whose run
 // goes to dir/run; returns the config's path.
 std::string write_training_config(const fs::path& dir) {
-  const fs::path file = dir / "config.yml";
-  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-                      << "\nvision_active: False\nmax_episode_steps: 100\n";
-  return file.string();
+  return cradle::test::self_touch_config(dir, 100);
 }
 
 TEST(Cli, BuildSceneWritesSceneAndTextures) {
@@ -133,10 +130,7 @@ TEST(Cli, TestInstallationWritesSceneLogAndVideo) {
 // writes trajectories, videos, evaluation.json and plots.
 TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
   const fs::path dir = temp_dir("eval");
-  std::ofstream(dir / "config.yml")
-      << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-      << "\nvision_active: False\nmax_episode_steps: 50\n"
-         "touch_function: force_vector\n";
+  cradle::test::self_touch_config(dir, 50, "touch_function: force_vector\n");
   CliResult r = run_cradle("random --config " + (dir / "config.yml").string() + " --train_for 120");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("training score"), std::string::npos) << r.out;

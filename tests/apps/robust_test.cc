@@ -42,12 +42,7 @@ void expect_one_line_error(const std::string& args) {
   EXPECT_LT(r.seconds, 60) << args;
 }
 
-std::string quick_config(const fs::path& dir) {
-  const fs::path file = dir / "config.yml";
-  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-                      << "\nvision_active: False\nmax_episode_steps: 100\n";
-  return file.string();
-}
+std::string quick_config(const fs::path& dir) { return cradle::test::self_touch_config(dir, 100); }
 
 TEST(Robust, FlagParseErrorsAreOneLineExitOne) {
   const fs::path dir = temp_dir("flags");

@@ -20,10 +20,7 @@ namespace fs = std::filesystem;
 
 // A quick self-touch config (no vision, 100-step episodes) writing to dir/run.
 std::string quick_config(const fs::path& dir) {
-  const fs::path file = dir / "config.yml";
-  std::ofstream(file) << "behavior: self_touch\nscene: crib\nsave_dir: " << (dir / "run").string()
-                      << "\nvision_active: False\nmax_episode_steps: 100\nsave_logs_every: 1000\n";
-  return file.string();
+  return cradle::test::self_touch_config(dir, 100, "save_logs_every: 1000\n");
 }
 
 // `cradle train` arguments for a tiny run of `algo`.
