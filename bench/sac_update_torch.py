@@ -15,7 +15,12 @@ same go, alternating with the Python timings, and the ratio is printed (its obs_
 import argparse
 import json
 import math
+import os
 import subprocess
+
+# One OpenBLAS thread, as Cradle runs it (src/apps/main.cc): otherwise OpenBLAS under PyTorch takes
+# a second core whatever --threads says, and the one-thread comparison is not one thread.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import torch
 import torch.nn as nn

@@ -8,6 +8,11 @@ weighted SaNCE step of the `half` sampler. Prints gradient steps/s per setting a
     /usr/bin/python3 bench/sami_update_torch.py [--iterations 5] [--threads 1 2] [--rounds 1]
 """
 import argparse
+import os
+
+# One OpenBLAS thread, as Cradle runs it (src/apps/main.cc): otherwise OpenBLAS under PyTorch takes
+# a second core whatever --threads says, and the one-thread comparison is not one thread.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import torch
 import torch.nn as nn
