@@ -20,6 +20,7 @@
 #include "eval/video.h"
 #include "sami/env.h"
 #include "sami/render.h"
+#include "sami/task.h"
 #include "sami/throughput.h"
 #include "train/sami/sami_train.h"
 
@@ -39,9 +40,7 @@ std::string list(const std::vector<double>& values) {
 }
 
 std::string cripple_text(const std::vector<int>& joints) {
-  std::string out;
-  for (int j : joints) out += (out.empty() ? "" : ",") + std::to_string(j);
-  return "[" + out + "]";
+  return "[" + sami::joints_text(joints, ",") + "]";
 }
 
 void random_episodes(const std::string& name, const std::string& split, int episodes,

@@ -158,6 +158,12 @@ Split split_from_name(std::string_view name) {
                   "'; expected train, moderate, extreme or a .yml file of task sets");
 }
 
+std::string joints_text(const std::vector<int>& joints, std::string_view separator) {
+  std::string out;
+  for (int j : joints) out += (out.empty() ? "" : std::string(separator)) + std::to_string(j);
+  return out;
+}
+
 std::vector<std::array<double, 2>> panda_cells(Split split) {
   switch (split) {
     case Split::kTrain:

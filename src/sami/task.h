@@ -68,6 +68,9 @@ std::vector<TaskSet> load_task_sets(EnvId id, const std::filesystem::path& file)
 // Throws UserError if a set asks for something the env does not vary or holds a bad value.
 void validate(EnvId id, const std::vector<TaskSet>& sets);
 
+// A crippling choice as text: its joints (Ant: legs) joined by `separator`, e.g. "0,4".
+std::string joints_text(const std::vector<int>& joints, std::string_view separator);
+
 // Panda's friction x mass grid cells of each split (§7.2).
 std::vector<std::array<double, 2>> panda_cells(Split split);
 

@@ -238,8 +238,8 @@ TEST(TmaRun, InterruptStopsAtAReportAndResumes) {
   const std::string progress_csv = (dir / "progress.csv").string();
   RunResult r = cradle::test::run(
       "timeout 300 sh -c '" + std::string(CRADLE_BINARY) + " " + args +
-      " --nb_env_steps 1 & pid=$!; " + "while kill -0 $pid 2>/dev/null && [ ! -s " + progress_csv +
-      " ]; do sleep 0.1; done; " + "sleep 1; kill -INT $pid; wait $pid' 2>&1");
+      " --nb_env_steps 1 & pid=$!; while kill -0 $pid 2>/dev/null && [ ! -s " + progress_csv +
+      " ]; do sleep 0.1; done; sleep 1; kill -INT $pid; wait $pid' 2>&1");
   ASSERT_EQ(r.status, 130) << r.out;
   EXPECT_NE(r.out.find("stopped by a signal at "), std::string::npos) << r.out;
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));

@@ -19,6 +19,7 @@
 #include "learn/run_files.h"
 #include "sami/env.h"
 #include "sami/render.h"
+#include "sami/task.h"
 #include "sami/vector.h"
 
 namespace cradle::train {
@@ -91,11 +92,7 @@ std::string cell_name(const sami::TaskSet& set, bool panda) {
   s << "mass {" << list(set.mass) << "} damping {" << list(set.damping) << "}";
   if (!set.cripple.empty()) {
     s << " cripple";
-    for (const auto& c : set.cripple) {
-      s << " [";
-      for (size_t k = 0; k < c.size(); ++k) s << (k ? "," : "") << c[k];
-      s << "]";
-    }
+    for (const auto& c : set.cripple) s << " [" << sami::joints_text(c, ",") << "]";
   }
   return s.str();
 }
@@ -407,11 +404,9 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
       // The parameters this episode drew (the task, within its task set): mass, damping, the
       // crippled joints ("0+4"; "none").
       const sami::Info& drawn = env->info();
-      std::string crippled;
-      for (int joint : drawn.crippled)
-        crippled += (crippled.empty() ? "" : "+") + std::to_string(joint);
-      const std::string episode_task = number(drawn.mass) + "," + number(drawn.damping) + "," +
-                                       (crippled.empty() ? "none" : crippled);
+      const std::string episode_task =
+          number(drawn.mass) + "," + number(drawn.damping) + "," +
+          (drawn.crippled.empty() ? "none" : sami::joints_text(drawn.crippled, "+"));
       ContextSac::Streams streams = learner.streams(1);
       double ret = 0;
       sami::StepResult r;
