@@ -23,7 +23,8 @@ RESUME=()
 if [ -e "$SAVE_DIR/checkpoints/latest.ckpt" ]; then RESUME=(--resume); fi
 
 # --signal=TERM@120: Slurm warns every rank 2 minutes before the time limit; the ranks agree to
-# stop at the next update and rank 0 writes a final checkpoint.
+# stop at the next update, rank 0 writes a final checkpoint and every rank exits 130: Slurm records
+# the job as FAILED, not COMPLETED, and resubmitting it resumes.
 srun --kill-on-bad-exit=1 "$CRADLE" train --distributed \
   --config "$CONFIG" --save-dir "$SAVE_DIR" \
   --algo ppo --envs "$SLURM_CPUS_PER_TASK" --steps 50000000 \

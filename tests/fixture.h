@@ -89,4 +89,14 @@ inline RunResult run_cradle(const std::string& args, const std::filesystem::path
   return run(command);
 }
 
+// Starts `cradle <args>`, sends it `signal` (e.g. "INT", "TERM") one second after `ready` exists
+// and is not empty, and waits for it to end (stdout and stderr together). A command that
+// ignores the signal meets a 5-minute timeout: status 124.
+inline RunResult run_cradle_then_signal(const std::string& args, const std::filesystem::path& ready,
+                                        const std::string& signal) {
+  return run("timeout 300 sh -c '" + std::string(CRADLE_BINARY) + " " + args +
+             " & pid=$!; while kill -0 $pid 2>/dev/null && [ ! -s " + ready.string() +
+             " ]; do sleep 0.1; done; sleep 1; kill -" + signal + " $pid; wait $pid' 2>&1");
+}
+
 }  // namespace cradle::test

@@ -1,7 +1,8 @@
 // `cradle launch --nproc N [--master-port P] -- cradle train ...`: one machine's torchrun. Starts N
 // ranks of the command with WORLD_SIZE, RANK, LOCAL_RANK, LOCAL_WORLD_SIZE, MASTER_ADDR and
 // MASTER_PORT set (and --distributed added to `cradle train`), forwards SIGINT and SIGTERM to them,
-// and when one fails stops the others and exits non-zero naming it.
+// and when one fails stops the others and exits non-zero naming it. Stopped by a signal, it exits
+// 130 once the ranks have saved.
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "apps/commands.h"
+#include "apps/interrupt.h"
 #include "core/error.h"
 
 namespace cradle::apps {
@@ -114,6 +116,7 @@ int launch(int nproc, int port, const std::string& addr, double grace,
 
   // Wait for them; forward signals; the first failure stops the rest.
   int failed = -1, failed_status = 0, running = nproc;
+  bool stop_forwarded = false, stopped = false;
   auto stop_others = [&](int signal) {
     for (const Rank& rank : ranks) {
       if (rank.running) kill(rank.pid, signal);
@@ -121,7 +124,10 @@ int launch(int nproc, int port, const std::string& addr, double grace,
   };
   std::chrono::steady_clock::time_point kill_at = std::chrono::steady_clock::time_point::max();
   while (running > 0) {
-    if (const int signal = forwarded.exchange(0)) stop_others(signal);
+    if (const int signal = forwarded.exchange(0)) {
+      stop_forwarded = true;
+      stop_others(signal);
+    }
     int status = 0;
     const pid_t pid = waitpid(-1, &status, WNOHANG);
     if (pid > 0) {
@@ -131,7 +137,11 @@ int launch(int nproc, int port, const std::string& addr, double grace,
       it->running = false;
       --running;
       const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      if (!ok && failed < 0) {
+      // After a forwarded stop, a rank that saved its checkpoint and exited 130 did as asked.
+      const bool saved =
+          stop_forwarded && WIFEXITED(status) && WEXITSTATUS(status) == kStoppedStatus;
+      stopped = stopped || saved;
+      if (!ok && !saved && failed < 0) {
         failed = static_cast<int>(it - ranks.begin());
         failed_status = status;
         if (running > 0) {
@@ -155,6 +165,12 @@ int launch(int nproc, int port, const std::string& addr, double grace,
   if (failed >= 0) {
     throw UserError("rank " + std::to_string(failed) + " " + describe(failed_status) +
                     " (the job can resume from its last checkpoint with --resume)");
+  }
+  if (stopped) {
+    std::fprintf(stderr,
+                 "cradle launch: stopped by a signal; the ranks saved their checkpoint: the same "
+                 "command with --resume continues\n");
+    throw Stopped{};
   }
   return 0;
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "apps/interrupt.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {
@@ -49,6 +50,8 @@ int main(int argc, char** argv) {
     for (char& ch : message) ch = ch == '\n' ? ' ' : ch;
     std::fprintf(stderr, "cradle: error: %s (see --help)\n", message.c_str());
     return 1;
+  } catch (const cradle::apps::Stopped&) {
+    return cradle::apps::kStoppedStatus;
   } catch (const cradle::UserError& e) {
     std::fprintf(stderr, "cradle: error: %s\n", e.what());
     return 1;

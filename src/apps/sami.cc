@@ -150,6 +150,7 @@ void register_learners(CLI::App& cmd) {
     if (r.stopped) {
       std::printf("stopped by a signal; continue with: cradle sami train --out %s --resume\n",
                   r.run.string().c_str());
+      throw Stopped{};  // exit 130
     }
   });
 

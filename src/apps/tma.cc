@@ -10,7 +10,6 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -398,10 +397,7 @@ void register_tma(CLI::App& app) {
           "stopped by a signal at %ld env steps; --resume continues from the checkpoint at %ld env "
           "steps (the last evaluation): cradle tma run ... --out %s --resume\n",
           r.env_steps, r.checkpoint_steps, o.out.string().c_str());
-      // Not 0: a campaign launcher must not count a stopped seed as finished. 130 is what a
-      // shell reports for a command ended by Ctrl-C.
-      std::fflush(stdout);
-      std::exit(130);
+      throw Stopped{};  // exit 130: `tma campaign` must not count the seed as finished
     }
   });
 

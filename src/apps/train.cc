@@ -17,6 +17,36 @@
 #include "train/trainer.h"
 
 namespace cradle::apps {
+namespace {
+
+// What a finished (or stopped) `cradle train` prints about its files and scores.
+void report_files(const Config& config, const train::TrainOptions& train,
+                  const train::TrainResult& r) {
+  std::printf("checkpoint: %s\n", r.checkpoint.c_str());
+  if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
+  if (r.evaluation) {
+    std::printf("evaluation of the trained policy (%zu episodes): %.4f +- %.4f\n",
+                r.evaluation->episodes.size(), r.evaluation->mean, r.evaluation->std);
+  }
+  if (r.random_evaluation) {
+    std::printf(
+        "evaluation of the random policy  (%zu episodes): %.4f +- %.4f  (trained / "
+        "random = %.2f)\n",
+        r.random_evaluation->episodes.size(), r.random_evaluation->mean, r.random_evaluation->std,
+        r.evaluation ? r.evaluation->mean / r.random_evaluation->mean : 0.0);
+  }
+  if (!train.env.empty()) {
+    std::printf("logs: %s/logs/progress.csv%s; plots: %s/plots/\n", config.save_dir.c_str(),
+                train.task_space.empty() ? "" : ", teacher.jsonl", config.save_dir.c_str());
+    return;
+  }
+  std::printf(
+      "logs: %s/logs/{training.jsonl, progress.csv}; plots: %s/plots/; videos: %s/videos/\n",
+      config.save_dir.c_str(), config.save_dir.c_str(), config.save_dir.c_str());
+}
+
+}  // namespace
+
 void register_train(CLI::App& app) {
   struct Options {
     std::string config;
@@ -115,8 +145,9 @@ void register_train(CLI::App& app) {
       }
       opts->train.hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
-    // srun and launch stop a distributed run's ranks with SIGTERM.
-    opts->train.stop = opts->distributed ? stop_on({SIGINT, SIGTERM}) : stop_on({SIGINT});
+    // Ctrl-C, or SIGTERM from srun, `cradle launch` or a scheduler's time limit, ends the run at
+    // its next update with a checkpoint.
+    opts->train.stop = stop_on({SIGINT, SIGTERM});
     std::unique_ptr<dist::ProcessGroup> group;
     if (opts->distributed) {
       group = std::make_unique<dist::ProcessGroup>(
@@ -135,30 +166,12 @@ void register_train(CLI::App& app) {
                   group->world_size(), static_cast<unsigned long long>(r.parameter_hash),
                   group->collectives(), group->collective_seconds());
     }
+    const bool stopped = opts->train.stop->load();
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
-                r.steps_per_second, opts->train.stop->load() ? " — interrupted" : "");
-    if (group && group->rank() > 0) return;  // rank 0 reports the run's files
-    std::printf("checkpoint: %s\n", r.checkpoint.c_str());
-    if (r.training_score) std::printf("training-log score: %.4f\n", *r.training_score);
-    if (r.evaluation) {
-      std::printf("evaluation of the trained policy (%zu episodes): %.4f +- %.4f\n",
-                  r.evaluation->episodes.size(), r.evaluation->mean, r.evaluation->std);
-    }
-    if (r.random_evaluation) {
-      std::printf(
-          "evaluation of the random policy  (%zu episodes): %.4f +- %.4f  (trained / "
-          "random = %.2f)\n",
-          r.random_evaluation->episodes.size(), r.random_evaluation->mean, r.random_evaluation->std,
-          r.evaluation ? r.evaluation->mean / r.random_evaluation->mean : 0.0);
-    }
-    if (!opts->train.env.empty()) {
-      std::printf("logs: %s/logs/progress.csv%s; plots: %s/plots/\n", config.save_dir.c_str(),
-                  opts->train.task_space.empty() ? "" : ", teacher.jsonl", config.save_dir.c_str());
-      return;
-    }
-    std::printf(
-        "logs: %s/logs/{training.jsonl, progress.csv}; plots: %s/plots/; videos: %s/videos/\n",
-        config.save_dir.c_str(), config.save_dir.c_str(), config.save_dir.c_str());
+                r.steps_per_second, stopped ? " — interrupted" : "");
+    // Rank 0 reports the run's files; a stopped run then exits 130, not 0.
+    if (!group || group->rank() == 0) report_files(config, opts->train, r);
+    if (stopped) throw Stopped{};
   });
 }
 

@@ -145,6 +145,25 @@ TEST(Resume, KillNineThenResumeEqualsUninterruptedRun) {
   fs::remove_all(whole);
 }
 
+// SIGTERM (a scheduler's time limit) ends training at its next update with a checkpoint and exit
+// 130; --resume continues from exactly that step.
+TEST(Resume, StopSignalSavesAndExits130) {
+  const fs::path dir = temp_dir("stopped");
+  CliRun r = cradle::test::run_cradle_then_signal(
+      train_args(dir) + " --steps 10000000", dir / "run" / "checkpoints" / "latest.ckpt", "TERM");
+  ASSERT_EQ(r.status, 130) << r.out;
+  EXPECT_NE(r.out.find(" — interrupted"), std::string::npos) << r.out;
+  const std::vector<std::string> rows = read_lines(dir / "run" / "logs" / "progress.csv");
+  ASSERT_GE(rows.size(), 2u);
+  const long stopped_at = std::stol(rows.back().substr(0, rows.back().find(',')));
+  ASSERT_LT(stopped_at, 10'000'000);
+  r = cradle(train_args(dir) + " --steps " + std::to_string(stopped_at + 256) + " --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::vector<std::string> resumed = read_lines(dir / "run" / "logs" / "progress.csv");
+  EXPECT_EQ(resumed.size(), rows.size() + 2);  // two more rollouts of 128 steps
+  fs::remove_all(dir);
+}
+
 // Truncated or altered checkpoints are refused with one line by resume and by evaluate.
 TEST(Resume, DamagedCheckpointsAreOneLineErrors) {
   const fs::path dir = temp_dir("damaged");

@@ -97,6 +97,26 @@ TEST(Launch, RefusesAMissingCommand) {
   EXPECT_NE(r.out.find("expected a command after --"), std::string::npos) << r.out;
 }
 
+// Ctrl-C to launch reaches both ranks: they agree on a step, rank 0 saves, each exits 130 and so
+// does launch (a stopped job is not a finished one); the same command with --resume continues.
+TEST(Launch, AStopSignalSavesAndExits130ThenTheJobResumes) {
+  const fs::path dir = fresh_dir("dist_stop");
+  RunResult r = cradle::test::run_cradle_then_signal(
+      "launch --nproc 2 -- cradle " + train_args(dir, "ppo", 1'000'000),
+      dir / "run" / "checkpoints" / "latest.ckpt", "INT");
+  ASSERT_EQ(r.status, 130) << r.out;
+  EXPECT_NE(r.out.find("cradle launch: stopped by a signal"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("rank 0 exited"), std::string::npos) << r.out;
+  const long stopped_at = last_step(dir / "run" / "logs" / "progress.csv");
+  ASSERT_GE(stopped_at, 64) << r.out;
+  ASSERT_LT(stopped_at, 1'000'000);
+  r = run_cradle("launch --nproc 2 -- cradle " + train_args(dir, "ppo", stopped_at + 128) +
+                 " --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), stopped_at + 128);
+  fs::remove_all(dir);
+}
+
 TEST(Distributed, AKilledRankStopsTheOtherThenTheJobResumes) {
   const fs::path dir = fresh_dir("dist_kill");
   const int port = free_port();

@@ -235,11 +235,8 @@ TEST(TmaRun, InterruptStopsAtAReportAndResumes) {
   // A run of a million steps, interrupted once it has begun (its progress.csv exists): it ends
   // by itself with exit 130, not 0, so a campaign does not take it for finished (a run that
   // ignored the signal would meet the 5-minute timeout: 124).
-  const std::string progress_csv = (dir / "progress.csv").string();
-  RunResult r = cradle::test::run(
-      "timeout 300 sh -c '" + std::string(CRADLE_BINARY) + " " + args +
-      " --nb_env_steps 1 & pid=$!; while kill -0 $pid 2>/dev/null && [ ! -s " + progress_csv +
-      " ]; do sleep 0.1; done; sleep 1; kill -INT $pid; wait $pid' 2>&1");
+  RunResult r =
+      cradle::test::run_cradle_then_signal(args + " --nb_env_steps 1", dir / "progress.csv", "INT");
   ASSERT_EQ(r.status, 130) << r.out;
   EXPECT_NE(r.out.find("stopped by a signal at "), std::string::npos) << r.out;
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
