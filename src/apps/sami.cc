@@ -164,15 +164,26 @@ void register_learners(CLI::App& cmd) {
   ev->callback([opts] {
     opts->eval.run = opts->run;
     const train::SamiEvalResult r = train::sami_evaluate(opts->eval);
-    std::printf("%-44s %8s %8s %12s %6s %6s %6s\n", "cell", "episodes", "success", "return", "push",
-                "roll", "pick");
-    for (const train::SamiCell& c : r.cells) {
-      std::printf("%-44s %8d %8.2f %12.2f %6.2f %6.2f %6.2f\n", c.name.c_str(), c.episodes,
-                  c.success_rate, c.mean_return, c.push, c.roll, c.pick_and_place);
+    // Panda's cells: success and the skill mix; locomotion's (long names last): the returns.
+    if (r.skills) {
+      std::printf("%-44s %8s %8s %12s %6s %6s %6s\n", "cell", "episodes", "success", "return",
+                  "push", "roll", "pick");
+    } else {
+      std::printf("%8s %12s %10s  %s\n", "episodes", "return", "std", "cell");
     }
-    std::printf("%s: success %.3f, mean return %.2f\nwritten: %s, %s, %s\n", r.split.c_str(),
-                r.success_rate, r.mean_return, r.json.string().c_str(), r.csv.string().c_str(),
-                r.contexts.string().c_str());
+    for (const train::SamiCell& c : r.cells) {
+      if (r.skills) {
+        std::printf("%-44s %8d %8.2f %12.2f %6.2f %6.2f %6.2f\n", c.name.c_str(), c.episodes,
+                    c.success_rate, c.mean_return, c.push, c.roll, c.pick_and_place);
+      } else {
+        std::printf("%8d %12.2f %10.2f  %s\n", c.episodes, c.mean_return, c.std_return,
+                    c.name.c_str());
+      }
+    }
+    if (r.skills) std::printf("%s: success %.3f, ", r.split.c_str(), r.success_rate);
+    if (!r.skills) std::printf("%s: ", r.split.c_str());
+    std::printf("mean return %.2f\nwritten: %s, %s, %s\n", r.mean_return, r.json.string().c_str(),
+                r.csv.string().c_str(), r.contexts.string().c_str());
   });
 
   CLI::App* tb = cmd.add_subcommand("table", "The paper's Table 1/2 over evaluated runs");

@@ -367,7 +367,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   const bool panda = id == sami::EnvId::kPandaPush;
   torch::set_num_threads(1);
 
-  SamiEvalResult result{.split = options.split};
+  SamiEvalResult result{.split = options.split, .skills = panda};
   const std::string stem = "eval_" + options.split;
   result.json = options.run / (stem + ".json");
   result.csv = options.run / (stem + ".csv");

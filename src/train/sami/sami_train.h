@@ -67,6 +67,8 @@ struct SamiEvalResult {
   std::string split;
   std::vector<SamiCell> cells;
   double success_rate = 0, mean_return = 0;  // over all episodes
+  // Panda: success and the push / roll / pick-and-place mix are measured (locomotion has none).
+  bool skills = false;
   std::filesystem::path json, csv, contexts;
 };
 SamiEvalResult sami_evaluate(const SamiEvalOptions& options);

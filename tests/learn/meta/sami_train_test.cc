@@ -85,6 +85,7 @@ TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
 
   const SamiEvalResult e = sami_evaluate({.run = dir, .split = "extreme", .episodes = 1});
   ASSERT_EQ(e.cells.size(), 8u);  // Panda's 8 extreme cells
+  EXPECT_TRUE(e.skills);
   for (const SamiCell& c : e.cells) {
     EXPECT_NEAR(c.push + c.roll + c.pick_and_place, 1.0, 1e-9) << c.name;  // one label each
   }
@@ -113,6 +114,7 @@ TEST(SamiEvaluate, ContextRowsNameTheDrawnTask) {
               .out = dir,
               .progress_bar = false});
   const SamiEvalResult e = sami_evaluate({.run = dir, .split = "extreme", .episodes = 2});
+  EXPECT_FALSE(e.skills);  // locomotion: no success or skill columns to print
   std::ifstream in(e.contexts);
   std::string line;
   std::getline(in, line);
