@@ -180,8 +180,8 @@ void register_learners(CLI::App& cmd) {
                     c.name.c_str());
       }
     }
-    if (r.skills) std::printf("%s: success %.3f, ", r.split.c_str(), r.success_rate);
-    if (!r.skills) std::printf("%s: ", r.split.c_str());
+    std::printf("%s: ", r.split.c_str());
+    if (r.skills) std::printf("success %.3f, ", r.success_rate);
     std::printf("mean return %.2f\nwritten: %s, %s, %s\n", r.mean_return, r.json.string().c_str(),
                 r.csv.string().c_str(), r.contexts.string().c_str());
   });
