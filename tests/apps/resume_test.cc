@@ -24,12 +24,9 @@ namespace fs = std::filesystem;
 
 using CliRun = cradle::test::RunResult;
 using cradle::test::read_lines;
+using cradle::test::run_cradle;
 
 CliRun run_shell(const std::string& command) { return cradle::test::run(command + " 2>&1"); }
-
-CliRun cradle(const std::string& args) {
-  return run_shell(std::string(CRADLE_BINARY) + " " + args);
-}
 
 fs::path temp_dir(const std::string& tag) { return cradle::test::fresh_dir("resume_" + tag); }
 
@@ -112,9 +109,9 @@ TEST(Resume, KillNineThenResumeEqualsUninterruptedRun) {
   ASSERT_TRUE(ready) << "training never passed its first checkpoint";
   const std::vector<nlohmann::json> before_kill = log_entries(killed / "run");
 
-  CliRun r = cradle(train_args(killed) + " --steps 1024 --resume");
+  CliRun r = run_cradle(train_args(killed) + " --steps 1024 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  r = cradle(train_args(whole) + " --steps 1024");
+  r = run_cradle(train_args(whole) + " --steps 1024");
   ASSERT_EQ(r.status, 0) << r.out;
 
   // progress.csv: every rollout once, steps strictly increasing, values as uninterrupted.
@@ -157,7 +154,7 @@ TEST(Resume, StopSignalSavesAndExits130) {
   ASSERT_GE(rows.size(), 2u);
   const long stopped_at = std::stol(rows.back().substr(0, rows.back().find(',')));
   ASSERT_LT(stopped_at, 10'000'000);
-  r = cradle(train_args(dir) + " --steps " + std::to_string(stopped_at + 256) + " --resume");
+  r = run_cradle(train_args(dir) + " --steps " + std::to_string(stopped_at + 256) + " --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   const std::vector<std::string> resumed = read_lines(dir / "run" / "logs" / "progress.csv");
   EXPECT_EQ(resumed.size(), rows.size() + 2);  // two more rollouts of 128 steps
@@ -167,7 +164,7 @@ TEST(Resume, StopSignalSavesAndExits130) {
 // Truncated or altered checkpoints are refused with one line by resume and by evaluate.
 TEST(Resume, DamagedCheckpointsAreOneLineErrors) {
   const fs::path dir = temp_dir("damaged");
-  CliRun r = cradle(train_args(dir) + " --steps 256");
+  CliRun r = run_cradle(train_args(dir) + " --steps 256");
   ASSERT_EQ(r.status, 0) << r.out;
   const fs::path latest = dir / "run" / "checkpoints" / "latest.ckpt";
   const std::string good = read_text(latest);
@@ -189,7 +186,7 @@ TEST(Resume, DamagedCheckpointsAreOneLineErrors) {
                                             "PK\x03\x04 not a checkpoint"};
   for (const std::string& bytes : damaged) {
     std::ofstream(latest, std::ios::binary | std::ios::trunc) << bytes;
-    r = cradle(train_args(dir) + " --steps 512 --resume");
+    r = run_cradle(train_args(dir) + " --steps 512 --resume");
     EXPECT_EQ(r.status, 1) << r.out;
     const std::vector<std::string> lines = message_lines(r.out);
     ASSERT_EQ(lines.size(), 1u) << r.out;
@@ -202,7 +199,7 @@ TEST(Resume, DamagedCheckpointsAreOneLineErrors) {
 // exit 1, the previous checkpoint intact, no temp file, the training log flushed.
 TEST(Resume, CheckpointWriteErrorKeepsPreviousCheckpoint) {
   const fs::path dir = temp_dir("full");
-  CliRun r = cradle(train_args(dir) + " --steps 256");
+  CliRun r = run_cradle(train_args(dir) + " --steps 256");
   ASSERT_EQ(r.status, 0) << r.out;
   const fs::path latest = dir / "run" / "checkpoints" / "latest.ckpt";
   const std::string before = read_text(latest);
@@ -223,7 +220,7 @@ TEST(Resume, CheckpointWriteErrorKeepsPreviousCheckpoint) {
   }
   EXPECT_GT(static_cast<long>(fs::file_size(dir / "run" / "logs" / "training.jsonl")), log_size);
   // And the run resumes from the intact checkpoint.
-  r = cradle(train_args(dir) + " --steps 512 --resume");
+  r = run_cradle(train_args(dir) + " --steps 512 --resume");
   EXPECT_EQ(r.status, 0) << r.out;
   fs::remove_all(dir);
 }
@@ -231,14 +228,14 @@ TEST(Resume, CheckpointWriteErrorKeepsPreviousCheckpoint) {
 // --resume keeps the checkpoint's algorithm: another --algo is refused; --hp values apply.
 TEST(Resume, ContradictingAlgoIsRefused) {
   const fs::path dir = temp_dir("algo");
-  CliRun r = cradle(train_args(dir) + " --steps 128");
+  CliRun r = run_cradle(train_args(dir) + " --steps 128");
   ASSERT_EQ(r.status, 0) << r.out;
-  r = cradle(train_args(dir) + " --steps 256 --resume --algo a2c");
+  r = run_cradle(train_args(dir) + " --steps 256 --resume --algo a2c");
   EXPECT_EQ(r.status, 1) << r.out;
   const std::vector<std::string> lines = message_lines(r.out);
   ASSERT_EQ(lines.size(), 1u) << r.out;
   EXPECT_NE(lines[0].find("ppo"), std::string::npos) << r.out;
-  r = cradle(train_args(dir) + " --steps 256 --resume --hp learning_rate=0.0001");
+  r = run_cradle(train_args(dir) + " --steps 256 --resume --hp learning_rate=0.0001");
   EXPECT_EQ(r.status, 0) << r.out;
   const std::vector<std::string> rows = read_lines(dir / "run" / "logs" / "progress.csv");
   EXPECT_NE(rows.back().find(",0.0001,"), std::string::npos) << rows.back();
@@ -249,17 +246,17 @@ TEST(Resume, ContradictingAlgoIsRefused) {
 // naming both, the same rewards continue.
 TEST(Resume, ContradictingIntrinsicIsRefused) {
   const fs::path dir = temp_dir("intrinsic");
-  CliRun r = cradle(train_args(dir) + " --steps 128");
+  CliRun r = run_cradle(train_args(dir) + " --steps 128");
   ASSERT_EQ(r.status, 0) << r.out;
   std::string other = train_args(dir);
   other.replace(other.find("--intrinsic body_part_novelty"), 29, "--intrinsic touch_count:2");
-  r = cradle(other + " --steps 256 --resume");
+  r = run_cradle(other + " --steps 256 --resume");
   EXPECT_EQ(r.status, 1) << r.out;
   const std::vector<std::string> lines = message_lines(r.out);
   ASSERT_EQ(lines.size(), 1u) << r.out;
   EXPECT_NE(lines[0].find("'body_part_novelty:1'"), std::string::npos) << r.out;
   EXPECT_NE(lines[0].find("'touch_count:2'"), std::string::npos) << r.out;
-  r = cradle(train_args(dir) + " --steps 256 --resume");
+  r = run_cradle(train_args(dir) + " --steps 256 --resume");
   EXPECT_EQ(r.status, 0) << r.out;
   fs::remove_all(dir);
 }
