@@ -23,6 +23,29 @@ void PolicyConfig::bind(Hyperparameters& table) {
   table.add("log_std_init", &log_std_init, "initial log std of the Gaussian (SB3 log_std_init)");
 }
 
+namespace {
+
+// A `void f(int)` thread-count setter of a library LibTorch loaded, or null.
+using SetThreads = void (*)(int);
+SetThreads find_set_threads(const char* symbol) {
+  return reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, symbol));
+}
+
+// LibTorch's intra-op thread count without at::set_num_threads, which also rebuilds the
+// pthreadpool (a thread destroyed and another created per call: around every SAC gradient step
+// that made a 17 ms step 51 ms). Debian's LibTorch runs its intra-op loops and oneDNN on OpenMP,
+// which read the calling thread's OpenMP setting (as at::get_num_threads does).
+void set_intra_op_threads(int threads) {
+  static const SetThreads set_openmp_threads = find_set_threads("omp_set_num_threads");
+  if (set_openmp_threads != nullptr) {
+    set_openmp_threads(threads);
+  } else {
+    torch::set_num_threads(threads);
+  }
+}
+
+}  // namespace
+
 void apply_torch_options(const LearnerOptions& options) {
   if (options.device != "cpu") {
     throw UserError("device '" + options.device + "': this build trains on the cpu only");
@@ -35,9 +58,7 @@ void apply_torch_options(const LearnerOptions& options) {
   torch::set_num_threads(options.torch_threads);
   // Debian's LibTorch does its matrix products in OpenBLAS, whose own thread pool LibTorch's
   // setting does not reach: its workers would spin on the cores the envs step on.
-  using SetThreads = void (*)(int);
-  if (auto* set_threads =
-          reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
+  if (const SetThreads set_threads = find_set_threads("openblas_set_num_threads")) {
     set_threads(options.torch_threads);
   }
 }
@@ -45,11 +66,11 @@ void apply_torch_options(const LearnerOptions& options) {
 ScopedTorchThreads::ScopedTorchThreads(int threads) {
   if (threads <= 0 || threads == torch::get_num_threads()) return;
   previous_ = torch::get_num_threads();
-  torch::set_num_threads(threads);
+  set_intra_op_threads(threads);
 }
 
 ScopedTorchThreads::~ScopedTorchThreads() {
-  if (previous_ > 0) torch::set_num_threads(previous_);
+  if (previous_ > 0) set_intra_op_threads(previous_);
 }
 
 int update_threads(const LearnerOptions& options, const ObsShape& shape) {

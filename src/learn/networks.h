@@ -41,8 +41,9 @@ struct PolicyConfig {
 void apply_torch_options(const LearnerOptions& options);
 
 // LibTorch's intra-op thread count set to `threads` for a scope (a gradient update), then set
-// back; 0 or less changes nothing. OpenBLAS keeps its one thread: two OpenBLAS threads under two
-// LibTorch threads made the hand-regard update 70 % slower.
+// back; 0 or less changes nothing. Cheap enough to open around every gradient step: no thread is
+// created or destroyed. OpenBLAS keeps its one thread: two OpenBLAS threads under two LibTorch
+// threads made the hand-regard update 70 % slower.
 class ScopedTorchThreads {
  public:
   explicit ScopedTorchThreads(int threads);
