@@ -21,8 +21,8 @@ _REFERENCE_KEYS = {
     "none": ["steps"],
 }
 # Cradle's extra keys in training.jsonl (kept with extras=True).
-_EXTRA_KEYS = ["right_eye_either_hand", "left_eye_either_hand", "physics_overflow", "score",
-               "wall_time"]
+_EXTRA_KEYS = ["right_eye_either_hand", "left_eye_either_hand", "physics_overflow",
+               "physics_diverged", "score", "wall_time"]
 
 
 def _wants_full_call(fn):

@@ -28,6 +28,29 @@ MimoSenses config_senses(const BabyBenchAssets& assets) {
           .vestibular = c.vestibular_active};
 }
 
+// How far a random start may leave one of MIMo's geoms inside the world below him (m).
+constexpr double kStartClearance = 0.002;
+
+// Raises MIMo on his free root until none of his geoms is more than kStartClearance inside a
+// world geom below or above it: random joint angles can put a limb through the floor or the
+// mattress, and MuJoCo's push-out forces then can make the physics diverge. Only contacts with a
+// mostly vertical normal count (lifting cannot resolve a limb through a crib bar).
+void lift_out_of_world(const mjModel* m, mjData* d, int root_joint) {
+  const int root_body = m->jnt_bodyid[root_joint];
+  const auto on_mimo = [&](int geom) { return m->body_rootid[m->geom_bodyid[geom]] == root_body; };
+  for (int pass = 0; pass < 4; ++pass) {
+    double depth = 0;
+    for (int c = 0; c < d->ncon; ++c) {
+      const mjContact& con = d->contact[c];
+      if (on_mimo(con.geom1) == on_mimo(con.geom2) || std::abs(con.frame[2]) < 0.7) continue;
+      depth = std::max(depth, -con.dist);
+    }
+    if (depth <= kStartClearance) return;
+    d->qpos[m->jnt_qposadr[root_joint] + 2] += depth;
+    mj_forward(m, d);
+  }
+}
+
 }  // namespace
 
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size) {
@@ -97,9 +120,15 @@ BabyBenchEnv::BabyBenchEnv(std::shared_ptr<const BabyBenchAssets> assets, std::u
     if (!held) free_joints_.push_back(j);
   }
 
+  root_joint_ = mj_name2id(m, mjOBJ_JOINT, "mimo_location");
+  if (root_joint_ < 0 || m->jnt_type[root_joint_] != mjJNT_FREE) {
+    throw UserError("BabyBench scene: MIMo has no free root joint 'mimo_location'");
+  }
+
   task_->declare(info_);
   contacts_.declare(info_);
   overflow_slot_ = info_.declare(kOverflowKey, InfoType::kInt);
+  diverged_slot_ = info_.declare(kDivergedKey, InfoType::kInt);
   core_.sim().restore(assets_->settled);
   core_.observe();
 }
@@ -206,6 +235,7 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
       q = r == 1.0 ? rng_.uniform(lo, hi) : rng_.uniform(q + r * (lo - q), q + r * (hi - q));
     }
     mj_forward(m, d);
+    lift_out_of_world(m, d, root_joint_);
   }
   // The cubes moved together along the line from MIMo's root to the red cube.
   if (cube_distance_ > 0) {
@@ -250,6 +280,11 @@ StepResult BabyBenchEnv::step(std::span<const double> action) {
   // A step whose physics overflowed MuJoCo's sizes is wrong: the episode ends there, counted.
   if (const int n = core_.sim().overflows()) {
     info_.add(overflow_slot_, n);
+    result.truncated = true;
+  }
+  // So is one whose physics diverged: MuJoCo restarted it from the model's initial state.
+  if (const int n = core_.sim().divergences()) {
+    info_.add(diverged_slot_, n);
     result.truncated = true;
   }
   Profile& profile = core_.profile();

@@ -64,6 +64,9 @@ class BabyBenchEnv final : public Env {
   // Info key: MuJoCo size overflows (contacts, constraints, stack) in this episode; the step that
   // overflows ends the episode (truncated). 0 in every normal episode.
   static constexpr const char* kOverflowKey = "physics_overflow";
+  // Info key: 1 when the physics diverged in this episode (NaN or huge values; MuJoCo reset the
+  // data mid-step); that step ends the episode (truncated). 0 in every normal episode.
+  static constexpr const char* kDivergedKey = "physics_diverged";
 
   static constexpr int kSettleSteps = 100;      // zero-action physics steps at construction
   static constexpr int kRandomResetSteps = 10;  // random actions applied at every reset
@@ -124,6 +127,7 @@ class BabyBenchEnv final : public Env {
   int log_slot_ = -1;
   bool skip_record_ = false;  // the current episode is already recorded (or not this env's)
   int overflow_slot_ = -1;    // info "physics_overflow": MuJoCo size overflows this episode
+  int diverged_slot_ = -1;    // info "physics_diverged": the physics diverged this episode
   Info info_;
   Rng rng_;
   std::vector<double> random_action_;
@@ -133,6 +137,7 @@ class BabyBenchEnv final : public Env {
   // root (m); <= 0: where the scene puts them.
   double cube_distance_ = 0;
   int mimo_body_ = -1;
+  int root_joint_ = -1;           // MIMo's free joint (mimo_location)
   std::vector<int> cube_qpos_;    // red, yellow and blue cube's free-joint qpos addresses
   std::vector<int> free_joints_;  // robot:* joints no active joint equality holds
   int steps_ = 0;

@@ -44,8 +44,8 @@ void add_textures(const std::vector<model::TextureAsset>& textures, XmlWriter& a
 SceneSizes scene_sizes(SceneKind kind) {
   // Measured maxima over 10,000 random-control physics steps from random joint poses (MuJoCo 2.2.2;
   // docs/babybench-physics.md): crib 52 contacts, 220 constraint rows, stack 10,648; cubes 234,
-  // 907, 120,470; base (MIMo free on the floor) 70, 268, 10,936, but random starts through the
-  // floor reach 250+ contacts and 800+ rows in the env. Sizes: about 3x for the crib, 1.4x the
+  // 907, 120,470; base (MIMo free on the floor) 70, 268, 10,936 (146 contacts and 496 rows in the
+  // env from random starts, which lift MIMo out of the floor; 250+ and 800+ before they did). Sizes: about 3x for the crib, 1.4x the
   // probe's (1.9x the env's) for the cubes, whose dense njmax^2 arrays dominate an env's memory
   // (njmax 1,300: 27 MB per mjData; 5,000: 310 MB), and 1,500 rows for the base. The stack is sized for njmax rows (it grows with rows x
   // dofs); its pages are touched only as used.

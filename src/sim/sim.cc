@@ -15,6 +15,13 @@ int overflow_warnings(const mjData* d) {
   return d->warning[mjWARN_CONTACTFULL].number + d->warning[mjWARN_CNSTRFULL].number;
 }
 
+// Divergence warnings MuJoCo has counted in d since its last reset: a position, velocity or
+// acceleration that is NaN or huge, after which MuJoCo resets d to the model's initial state.
+int divergence_warnings(const mjData* d) {
+  return d->warning[mjWARN_BADQPOS].number + d->warning[mjWARN_BADQVEL].number +
+         d->warning[mjWARN_BADQACC].number;
+}
+
 // MuJoCo 2.2.2 reports a stack overflow as an error ("... stack ...").
 bool is_stack_overflow(const UserError& e) {
   std::string text = e.what();
@@ -36,10 +43,12 @@ Sim::Sim(const mjModel* m, ActuationModel kind, int frame_skip)
 void Sim::step(std::span<const double> action) {
   mjData* d = d_.get();
   overflows_ = 0;
+  divergences_ = 0;
   actuation_->apply(action, d);
-  for (int i = 0; i < frame_skip_ && overflows_ == 0; ++i) {
+  for (int i = 0; i < frame_skip_ && overflows_ == 0 && divergences_ == 0; ++i) {
     actuation_->substep(d);
     const int before = overflow_warnings(d);
+    const int diverged_before = divergence_warnings(d);
     try {
       mj_step(m_, d);
     } catch (const UserError& e) {
@@ -47,7 +56,12 @@ void Sim::step(std::span<const double> action) {
       d->pstack = 0;  // the aborted step's stack frames
       ++overflows_;
     }
-    overflows_ += overflow_warnings(d) - before;
+    // MuJoCo's reset after a divergence also zeroes the overflow counts: compare nothing then.
+    if (divergence_warnings(d) != diverged_before) {
+      ++divergences_;
+    } else {
+      overflows_ += overflow_warnings(d) - before;
+    }
   }
 }
 

@@ -40,10 +40,14 @@ class Sim {
   // One env step: the action once, then frame_skip physics substeps. A substep that overflows
   // MuJoCo's preallocated sizes (contacts beyond nconmax, constraint rows beyond njmax: MuJoCo
   // drops them and warns; the stack: MuJoCo errors mid-step) ends the step early, its physics
-  // wrong, and is counted in overflows() for the caller to end the episode.
+  // wrong, and is counted in overflows() for the caller to end the episode. A substep that
+  // diverges (NaN or huge positions, velocities or accelerations: MuJoCo warns and resets the
+  // data to the model's initial state mid-episode) ends the step too, counted in divergences().
   void step(std::span<const double> action);
   // Overflows in the last step() (0 when its physics is right).
   int overflows() const { return overflows_; }
+  // Divergences in the last step() (0 or 1; 0 when its physics is right).
+  int divergences() const { return divergences_; }
   // mj_resetData and a zero action.
   void reset();
 
@@ -57,6 +61,7 @@ class Sim {
   std::unique_ptr<Actuation> actuation_;
   int frame_skip_;
   int overflows_ = 0;
+  int divergences_ = 0;
 };
 
 }  // namespace cradle::sim

@@ -41,12 +41,14 @@ def test_step_protocol_and_truncation(make_config):
     env = cradle.make_env(make_config("selftouch", max_episode_steps=5), training=False)
     obs, info = env.reset(seed=0)
     assert set(obs) == {"observation", "touch", "vestibular"}
-    # The reference's keys, plus Cradle's count of MuJoCo size overflows (0 in normal episodes).
+    # The reference's keys, plus Cradle's counts of MuJoCo size overflows and of diverged physics
+    # (0 in normal episodes).
     assert info == {
         "right_hand_touches": [],
         "left_hand_touches": [],
         "steps": 0,
         "physics_overflow": 0,
+        "physics_diverged": 0,
     }
     for t in range(5):
         obs, reward, terminated, truncated, info = env.step(np.zeros(env.action_space.shape))

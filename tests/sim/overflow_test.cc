@@ -1,6 +1,6 @@
 // MuJoCo size overflows (issue 19, item 2): a step that runs out of contacts, constraint rows or
 // stack is counted and ends early instead of silently dropping physics; the next step is normal
-// once the cause is gone.
+// once the cause is gone. A diverging step is counted and ends early the same way.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -86,6 +86,28 @@ TEST(Overflow, StackOverflowIsCountedAndTheSimGoesOn) {
     EXPECT_EQ(sim.data()->pstack, 0);
   }
   EXPECT_GT(n, 80);
+}
+
+// A diverging substep (here a velocity beyond MuJoCo's 1e10 bound) makes MuJoCo reset the data
+// mid-step; the step ends there and says so, and the next step is normal again.
+TEST(Overflow, DivergenceEndsTheStepAndIsCounted) {
+  const auto m = compile(boxes("nconmax=\"100\" njmax=\"400\" nstack=\"200000\""));
+  ASSERT_NE(m, nullptr);
+  Sim sim(m.get(), ActuationModel::kSpringDamper, 5);
+  sim.step({});
+  EXPECT_EQ(sim.divergences(), 0);
+  sim.data()->qvel[0] = 1e11;
+  ::testing::internal::CaptureStderr();
+  sim.step({});
+  const std::string warning = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(warning.find("QVEL"), std::string::npos) << warning;
+  EXPECT_EQ(sim.divergences(), 1);
+  EXPECT_EQ(sim.overflows(), 0);
+  // Stopped at the diverging substep: MuJoCo's reset, then that one step (not five).
+  EXPECT_NEAR(sim.data()->time, m->opt.timestep, 1e-12);
+  EXPECT_NEAR(sim.data()->qpos[2], m->qpos0[2], 1e-3);  // box 0 back at its initial height
+  sim.step({});
+  EXPECT_EQ(sim.divergences(), 0);
 }
 
 }  // namespace
