@@ -98,21 +98,31 @@ torch::Tensor CriticImpl::activate(const torch::Tensor& x) const {
 }
 
 torch::Tensor CriticImpl::forward(const ObsBatch& observation, const torch::Tensor& actions) {
-  const torch::Tensor input = torch::cat({encoder_->forward(observation), actions}, 1);
+  const torch::Tensor features = encoder_->forward(observation);
   // Every critic reads the same input: broadcast over the critics, not copied.
-  torch::Tensor h = input.unsqueeze(0).expand({critics_, input.size(0), input.size(1)});
-  for (size_t l = 0; l < weights_.size(); ++l) {
-    h = torch::baddbmm(biases_[l], h, weights_[l]);
-    if (l + 1 < weights_.size()) h = activate(h);
+  const auto broadcast = [this](const torch::Tensor& x) {
+    return x.unsqueeze(0).expand({critics_, x.size(0), x.size(1)});
+  };
+  // The first layer on [features, actions] as its two row blocks of weights, so that a gradient
+  // wanted for the actions only (the actor's loss, critics frozen) is not computed for the
+  // features too.
+  const int64_t f = features.size(1);
+  torch::Tensor h = torch::baddbmm(biases_[0], broadcast(features), weights_[0].narrow(1, 0, f));
+  h = torch::baddbmm(h, broadcast(actions), weights_[0].narrow(1, f, actions.size(1)));
+  for (size_t l = 1; l < weights_.size(); ++l) {
+    h = torch::baddbmm(biases_[l], activate(h), weights_[l]);
   }
   return h.squeeze(2);
 }
 
 torch::Tensor CriticImpl::q1(const ObsBatch& observation, const torch::Tensor& actions) {
-  torch::Tensor h = torch::cat({encoder_->forward(observation), actions}, 1);
-  for (size_t l = 0; l < weights_.size(); ++l) {
-    h = torch::addmm(biases_[l][0], h, weights_[l][0]);
-    if (l + 1 < weights_.size()) h = activate(h);
+  const torch::Tensor features = encoder_->forward(observation);
+  // The first layer in two row blocks, as in forward().
+  const int64_t f = features.size(1);
+  torch::Tensor h = torch::addmm(biases_[0][0], features, weights_[0][0].narrow(0, 0, f));
+  h = torch::addmm(h, actions, weights_[0][0].narrow(0, f, actions.size(1)));
+  for (size_t l = 1; l < weights_.size(); ++l) {
+    h = torch::addmm(biases_[l][0], activate(h), weights_[l][0]);
   }
   return h.squeeze(1);
 }

@@ -243,6 +243,19 @@ TEST(FusedCritic, MatchesSeparateMlpsWithCopiedWeights) {
           torch::allclose(fused->weight(0).grad()[i], first->weight.grad().t(), 1e-4, 1e-5));
       EXPECT_TRUE(torch::allclose(fused->bias(0).grad()[i][0], first->bias.grad(), 1e-4, 1e-5));
     }
+    // The actions' gradient (the actor's loss), through both Qs and through Q1 alone.
+    const torch::Tensor fused_actions = actions.clone().requires_grad_(true);
+    const torch::Tensor separate_input = input.clone().requires_grad_(true);
+    fused->forward(obs, fused_actions).sum().backward();
+    (separate[0]->forward(separate_input).sum() + separate[1]->forward(separate_input).sum())
+        .backward();
+    EXPECT_TRUE(
+        torch::allclose(fused_actions.grad(), separate_input.grad().narrow(1, 7, 3), 1e-4, 1e-5));
+    const torch::Tensor q1_actions = actions.clone().requires_grad_(true);
+    const torch::Tensor q1_input = input.clone().requires_grad_(true);
+    fused->q1(obs, q1_actions).sum().backward();
+    separate[0]->forward(q1_input).sum().backward();
+    EXPECT_TRUE(torch::allclose(q1_actions.grad(), q1_input.grad().narrow(1, 7, 3), 1e-4, 1e-5));
   }
 }
 
