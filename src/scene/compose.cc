@@ -42,18 +42,19 @@ void add_textures(const std::vector<model::TextureAsset>& textures, XmlWriter& a
 }  // namespace
 
 SceneSizes scene_sizes(SceneKind kind) {
-  // Measured maxima over 10,000 random-control physics steps from random joint poses (MuJoCo 2.2.2;
-  // docs/babybench-physics.md): crib 52 contacts, 220 constraint rows, stack 10,648; cubes 234,
-  // 907, 120,470; base (MIMo free on the floor) 70, 268, 10,936 (146 contacts and 496 rows in the
-  // env from random starts, which lift MIMo out of the floor; 250+ and 800+ before they did). Sizes: about 3x for the crib, 1.4x the
-  // probe's (1.9x the env's) for the cubes, whose dense njmax^2 arrays dominate an env's memory
-  // (njmax 1,300: 27 MB per mjData; 5,000: 310 MB), and 1,500 rows for the base. The stack is sized for njmax rows (it grows with rows x
-  // dofs); its pages are touched only as used.
+  // Measured maxima over 10,000 random-control physics steps from random joint poses (MuJoCo
+  // 2.2.2; docs/babybench-physics.md): crib 52 contacts, 220 constraint rows, stack 10,648; cubes
+  // 234, 907, 120,470; base (MIMo free on the floor) 70, 268, 10,936, and in the env from random
+  // starts, which lift MIMo out of the floor, at most 168 contacts and 562 rows over 3 x 10,000
+  // steps (250+ and 800+ before they did). Sizes: about 3x for the crib, 1.4x the probe's (1.9x
+  // the env's) for the cubes, whose dense njmax^2 arrays dominate an env's memory (njmax 1,300:
+  // 27 MB per mjData; 5,000: 310 MB), and 2.4x / 1.8x the env's for the base. The stack is sized
+  // for njmax rows (it grows with rows x dofs); its pages are touched only as used.
   switch (kind) {
     case SceneKind::kCrib:
       return {.nconmax = 200, .njmax = 600, .nstack = 100000};
     case SceneKind::kBase:
-      return {.nconmax = 1000, .njmax = 1500, .nstack = 500000};
+      return {.nconmax = 400, .njmax = 1000, .nstack = 500000};
     case SceneKind::kCubes:
       return {.nconmax = 600, .njmax = 1300, .nstack = 500000};
   }
