@@ -15,12 +15,9 @@ int overflow_warnings(const mjData* d) {
   return d->warning[mjWARN_CONTACTFULL].number + d->warning[mjWARN_CNSTRFULL].number;
 }
 
-// Divergence warnings MuJoCo has counted in d since its last reset: a position, velocity or
-// acceleration that is NaN or huge, after which MuJoCo resets d to the model's initial state.
-int divergence_warnings(const mjData* d) {
-  return d->warning[mjWARN_BADQPOS].number + d->warning[mjWARN_BADQVEL].number +
-         d->warning[mjWARN_BADQACC].number;
-}
+// MuJoCo's warnings of a position, velocity or acceleration that is NaN or huge, after which it
+// resets d to the model's initial state (and counts the warning anew from 1).
+constexpr int kDivergenceWarnings[] = {mjWARN_BADQPOS, mjWARN_BADQVEL, mjWARN_BADQACC};
 
 // MuJoCo 2.2.2 reports a stack overflow as an error ("... stack ...").
 bool is_stack_overflow(const UserError& e) {
@@ -48,7 +45,9 @@ void Sim::step(std::span<const double> action) {
   for (int i = 0; i < frame_skip_ && overflows_ == 0 && divergences_ == 0; ++i) {
     actuation_->substep(d);
     const int before = overflow_warnings(d);
-    const int diverged_before = divergence_warnings(d);
+    // The reset after a divergence sets its count back to 1, so a count carried over from an
+    // earlier divergence would hide this one: start from 0.
+    for (const int w : kDivergenceWarnings) d->warning[w].number = 0;
     try {
       mj_step(m_, d);
     } catch (const UserError& e) {
@@ -57,7 +56,7 @@ void Sim::step(std::span<const double> action) {
       ++overflows_;
     }
     // MuJoCo's reset after a divergence also zeroes the overflow counts: compare nothing then.
-    if (divergence_warnings(d) != diverged_before) {
+    if (std::ranges::any_of(kDivergenceWarnings, [d](int w) { return d->warning[w].number > 0; })) {
       ++divergences_;
     } else {
       overflows_ += overflow_warnings(d) - before;

@@ -108,6 +108,12 @@ TEST(Overflow, DivergenceEndsTheStepAndIsCounted) {
   EXPECT_NEAR(sim.data()->qpos[2], m->qpos0[2], 1e-3);  // box 0 back at its initial height
   sim.step({});
   EXPECT_EQ(sim.divergences(), 0);
+  // A second divergence in the same life of the data is counted too.
+  sim.data()->qvel[0] = 1e11;
+  ::testing::internal::CaptureStderr();
+  sim.step({});
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(sim.divergences(), 1);
 }
 
 }  // namespace
