@@ -32,9 +32,10 @@ MimoSenses config_senses(const BabyBenchAssets& assets) {
 constexpr double kStartClearance = 0.002;
 
 // Raises MIMo on his free root until none of his geoms is more than kStartClearance inside a
-// world geom below or above it: random joint angles can put a limb through the floor or the
-// mattress, and MuJoCo's push-out forces then can make the physics diverge. Only contacts with a
-// mostly vertical normal count (lifting cannot resolve a limb through a crib bar).
+// world geom below it: random joint angles can put a limb through the floor or the mattress, and
+// MuJoCo's push-out forces then can make the physics diverge. Only contacts with a mostly
+// vertical normal count (lifting cannot resolve a limb through a crib bar); the scenes have
+// nothing above MIMo.
 void lift_out_of_world(const mjModel* m, mjData* d, int root_joint) {
   const int root_body = m->jnt_bodyid[root_joint];
   const auto on_mimo = [&](int geom) { return m->body_rootid[m->geom_bodyid[geom]] == root_body; };
@@ -156,14 +157,13 @@ void BabyBenchEnv::set_reset_options(const ResetOptions& options) {
     // A curriculum's reach distance: the cubes stack this far from MIMo (cubes scene only).
     if (name == "cube_distance") {
       const mjModel* m = model();
-      mimo_body_ = mj_name2id(m, mjOBJ_BODY, "mimo_location");
       cube_qpos_.clear();
       for (const char* cube : {"red_cube", "yellow_cube", "blue_cube"}) {
         const int b = mj_name2id(m, mjOBJ_BODY, cube);
         if (b >= 0 && m->body_jntnum[b] == 1)
           cube_qpos_.push_back(m->jnt_qposadr[m->body_jntadr[b]]);
       }
-      if (mimo_body_ < 0 || cube_qpos_.size() != 3) {
+      if (cube_qpos_.size() != 3) {
         throw UserError("reset option cube_distance needs the cubes scene (scene: cubes)");
       }
       if (!(value >= 0.1 && value <= 0.8)) {
@@ -240,7 +240,7 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
   // The cubes moved together along the line from MIMo's root to the red cube.
   if (cube_distance_ > 0) {
     mjData* d = sim.data();
-    const double* root = d->xpos + 3 * mimo_body_;
+    const double* root = d->xpos + 3 * model()->jnt_bodyid[root_joint_];
     const double dx = d->qpos[cube_qpos_[0]] - root[0], dy = d->qpos[cube_qpos_[0] + 1] - root[1];
     const double shift = cube_distance_ / std::max(std::hypot(dx, dy), 1e-9) - 1;
     for (int q : cube_qpos_) {

@@ -136,7 +136,6 @@ class BabyBenchEnv final : public Env {
   // Reset option cube_distance (cubes scene): the stacked cubes' horizontal distance from MIMo's
   // root (m); <= 0: where the scene puts them.
   double cube_distance_ = 0;
-  int mimo_body_ = -1;
   int root_joint_ = -1;           // MIMo's free joint (mimo_location)
   std::vector<int> cube_qpos_;    // red, yellow and blue cube's free-joint qpos addresses
   std::vector<int> free_joints_;  // robot:* joints no active joint equality holds
