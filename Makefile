@@ -54,11 +54,14 @@ run: build
 test: build
 	@cd $(BUILD_DIR) && $(NICE) ctest --output-on-failure -j $(JOBS)
 
+# `make install CMAKE_INSTALL_PREFIX=DIR`: the CLI into DIR/bin and its data files into
+# DIR/share/cradle (default: the prefix the build was configured with, /usr/local).
 install: build
-	@cmake --install $(BUILD_DIR)
+	@cmake --install $(BUILD_DIR) $(if $(CMAKE_INSTALL_PREFIX),--prefix $(CMAKE_INSTALL_PREFIX))
 
-# The Python package `cradle` into Debian python3's user site-packages (override PYTHON_PREFIX to
-# install elsewhere, then put that folder on PYTHONPATH).
+# The Python package `cradle` (with its data files and the CLI in cradle/bin) into Debian python3's
+# user site-packages (override PYTHON_PREFIX to install elsewhere, then put that folder on
+# PYTHONPATH). Into a venv with the `cradle` command: pip install --no-build-isolation .
 PYTHON ?= /usr/bin/python3
 PYTHON_PREFIX ?= $(shell $(PYTHON) -c 'import site; print(site.getusersitepackages())')
 install-python: build

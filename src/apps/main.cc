@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "apps/interrupt.h"
 #include "core/error.h"
+#include "core/resources.h"
 
 int main(int argc, char** argv) {
   // Mesa's software rasterizer spawns its own threads by default; at eye resolutions they only
@@ -26,7 +27,12 @@ int main(int argc, char** argv) {
     }
   }
   CLI::App app{"Cradle: the BabyBench infant benchmark (MIMo in MuJoCo), in C++."};
-  app.set_version_flag("--version", CRADLE_VERSION);
+  // --version also names the data files this program uses: its installed copy's or the source
+  // tree's.
+  const auto& installed = cradle::installed_resources();
+  const std::string data =
+      installed ? installed->string() : std::string(CRADLE_SOURCE_DIR) + " (source tree)";
+  app.set_version_flag("--version", std::string(CRADLE_VERSION) + "\ndata files: " + data);
   app.require_subcommand(1);
   cradle::apps::register_build_scene(app);
   cradle::apps::register_model_info(app);

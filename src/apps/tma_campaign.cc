@@ -33,6 +33,7 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/resources.h"
 #include "envs/tma/tma_env.h"
 #include "eval/video.h"
 #include "learn/hyperparams.h"
@@ -636,7 +637,10 @@ int analyze(const std::string& results, const std::string& out, const std::strin
   }
   const char* env_python = std::getenv("CRADLE_PYTHON");
   const std::string python = env_python && *env_python ? env_python : CRADLE_PYTHON;
-  const std::string script = std::string(CRADLE_PYTHON_DIR) + "/cradle/tma_analysis.py";
+  // An installed copy runs its own script, a build-tree binary the source tree's.
+  const auto& installed = installed_resources();
+  const std::string script = installed ? (*installed / "tma_analysis.py").string()
+                                       : std::string(CRADLE_PYTHON_DIR) + "/cradle/tma_analysis.py";
   std::vector<std::string> argv = {python, script, results, "--out", out};
   if (!baseline.empty()) argv.insert(argv.end(), {"--baseline", baseline});
   std::vector<char*> cargv;

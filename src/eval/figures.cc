@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 extern char** environ;
 
@@ -89,7 +90,10 @@ bool Figures::draw(const std::filesystem::path& spec) const {
   }
   const char* env_python = std::getenv("CRADLE_PYTHON");
   const std::string python = env_python && *env_python ? env_python : CRADLE_PYTHON;
-  const std::string script = std::string(CRADLE_PYTHON_DIR) + "/cradle_figures.py";
+  // An installed copy draws with its own script, a build-tree binary with the source tree's.
+  const auto& installed = installed_resources();
+  const std::string script = installed ? (*installed / "cradle_figures.py").string()
+                                       : std::string(CRADLE_PYTHON_DIR) + "/cradle_figures.py";
   if (!std::filesystem::exists(script) || run(python, script, spec.string()) != 0) {
     std::fprintf(stderr,
                  "cradle: figures not drawn (they need %s with matplotlib and %s); their data is "

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace cradle::tma {
 
@@ -67,6 +68,10 @@ void Cppn::generate(const std::array<double, 3>& input, int points, std::vector<
 std::filesystem::path data_dir() {
   std::vector<std::filesystem::path> candidates;
   if (const char* env = std::getenv("CRADLE_TMA_DATA")) candidates.emplace_back(env);
+  // An installed copy uses its own data before the source tree it was built from.
+  if (const auto& installed = installed_resources()) {
+    candidates.push_back(*installed / "data" / "teachmyagent");
+  }
   candidates.emplace_back(CRADLE_TMA_SOURCE_DATA);
   candidates.emplace_back(CRADLE_TMA_INSTALL_DATA);
   for (const auto& dir : candidates) {
