@@ -183,7 +183,7 @@ class BabyBenchEnv(_EnvBase):
         self.max_episode_steps = self._config.max_episode_steps
         self.dt = self._core.dt
 
-    # The reference's documented attributes (views of the C++ state; see README "Python").
+    # The reference's documented attributes (views of the C++ state; see docs/python.md).
     @property
     def model(self):
         """The compiled model: nu, nq, nv, nbody, ..., actuator(i).name, joint(name).id, ..."""
