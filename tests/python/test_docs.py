@@ -24,6 +24,7 @@ import shutil
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
@@ -119,6 +120,28 @@ def test_docs_have_runnable_blocks():
     assert len(ran) >= 10, ran
     for block_id, _, _, skip, expect in BLOCKS:
         assert skip is None or not expect, f"{block_id}: skipped but expects outputs"
+
+
+def subcommands(*words):
+    """The subcommand names `cradle WORDS... --help` lists."""
+    text = subprocess.run([cradle_binary(), *words, "--help"], capture_output=True, text=True,
+                          check=True).stdout
+    listed = text.split("Subcommands:", 1)[1] if "Subcommands:" in text else ""
+    return re.findall(r"(?m)^  (\S+)\s", listed)
+
+
+def test_cli_reference_has_every_subcommand():
+    """docs/cli.md has a row for every subcommand the CLI lists, nested ones included."""
+    reference = (ROOT / "docs" / "cli.md").read_text()
+    missing, level = [], [[]]
+    with ThreadPoolExecutor(4) as pool:
+        while level:
+            paths = [words + [name] for words in level for name in subcommands(*words)]
+            nested = list(pool.map(lambda path: subcommands(*path), paths))
+            level = [path for path, names in zip(paths, nested) if names]
+            missing += [" ".join(path) for path, names in zip(paths, nested)
+                        if not names and f"`cradle {' '.join(path)}" not in reference]
+    assert not missing, f"docs/cli.md lacks rows for: {missing}"
 
 
 @pytest.mark.parametrize("block_id,lang,code,skip,expect", BLOCKS, ids=[b[0] for b in BLOCKS])
