@@ -5,7 +5,7 @@
     obs, info = env.reset(seed=0)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 
-See README.md, section "Python".
+See docs/python.md.
 """
 
 from . import sami, spaces, teach
