@@ -12,6 +12,7 @@ packages=(
   libtorch-dev libopenblas0-pthread
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   python3 python3-numpy python3-dev pybind11-dev python3-pytest
+  python3-pip python3-venv python3-setuptools python3-wheel  # pip install . (offline)
   ccache
   libbox2d-dev libcairo2-dev libzip-dev libeigen3-dev
   python3-matplotlib python3-scipy python3-pandas

@@ -8,6 +8,8 @@
 See docs/python.md.
 """
 
+import importlib
+
 from . import sami, spaces, teach
 from ._cradle import __version__
 from .env import (
@@ -25,6 +27,16 @@ from .vector import VectorEnv
 from .wrappers import ActionWrapper, ObservationWrapper, RewardWrapper, Wrapper
 
 register_gymnasium_envs()
+
+# Submodules loaded on first use, so `cradle.tma.make(...)` works after `import cradle`:
+# TeachMyAgent, its campaign analysis (needs pandas) and the SB3 vector env (needs SB3).
+_LAZY_SUBMODULES = ("tma", "tma_analysis", "sb3")
+
+
+def __getattr__(name):
+    if name in _LAZY_SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "ENV_IDS",

@@ -66,7 +66,7 @@ def venv(tmp_path_factory):
 ENVS_SCRIPT = textwrap.dedent("""
     import json
     import cradle
-    from cradle import _cradle, sami, tma
+    from cradle import _cradle
 
     def steps(env):
         env.reset(seed=0)
@@ -76,8 +76,8 @@ ENVS_SCRIPT = textwrap.dedent("""
         env.close()
 
     steps(cradle.make("BabyBench-SelfTouch"))
-    steps(tma.make(tma.PARKOUR))
-    steps(sami.make(sami.ENV_NAMES[0]))
+    steps(cradle.tma.make(cradle.tma.PARKOUR))
+    steps(cradle.sami.make(cradle.sami.ENV_NAMES[0]))
     print(json.dumps({"package": cradle.__file__, "configs": cradle.env.CONFIG_DIR,
                       "tma_data": _cradle.tma_data_dir()}))
 """)
