@@ -142,3 +142,16 @@ def test_editable_install_imports_the_build_tree(tmp_path):
     # The command runs the build tree's program, which reads the source tree.
     version = run([os.path.join(venv, "bin", "cradle"), "--version"], venv).stdout
     assert f"data files: {SOURCE} (source tree)" in version, version
+
+
+def test_cmake_install_uses_the_data_of_its_prefix(tmp_path):
+    # `make install CMAKE_INSTALL_PREFIX=...` without the rebuild `make install` starts with.
+    build = os.environ.get("CRADLE_BUILD_DIR") or os.path.join(SOURCE, "build")
+    prefix = tmp_path / "prefix"
+    subprocess.run(["cmake", "--install", build, "--prefix", str(prefix)], check=True,
+                   capture_output=True)
+    cradle = str(prefix / "bin" / "cradle")
+    version = run([cradle, "--version"], str(prefix)).stdout
+    assert f"data files: {prefix / 'share' / 'cradle'}" in version, version
+    run([cradle, "tma", "random", "--env", "parkour", "--steps", "20"], str(prefix),
+        cwd=str(tmp_path))
