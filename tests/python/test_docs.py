@@ -108,8 +108,8 @@ def workspace(tmp):
         (tmp / name).symlink_to(ROOT / name)
     (tmp / "build").mkdir()
     (tmp / "build" / "cradle").symlink_to(os.path.abspath(cradle_binary()))
-    package = next(p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep)
-                   if p and (pathlib.Path(p) / "cradle").is_dir())
+    package = next((p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep)
+                    if p and (pathlib.Path(p) / "cradle").is_dir()), str(ROOT / "build" / "python"))
     (tmp / "build" / "python").symlink_to(os.path.abspath(package))
 
 
