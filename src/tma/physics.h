@@ -63,6 +63,11 @@ struct Tag {
   Rgb color1, color2;
 };
 
+// A point in world units at full precision.
+struct WorldPoint {
+  double x = 0, y = 0;
+};
+
 // A point in world units as Box2D's float vector.
 inline b2Vec2 at(double x, double y) {
   return b2Vec2(static_cast<float>(x), static_cast<float>(y));
@@ -70,6 +75,29 @@ inline b2Vec2 at(double x, double y) {
 
 inline Tag* tag_of(const b2Body* body) {
   return reinterpret_cast<Tag*>(const_cast<b2Body*>(body)->GetUserData().pointer);
+}
+
+// Revolute limits as Box2D 2.3 (the reference's engine) solves them; call before every world step.
+// 2.3 decides each step, from the angle at its start, whether a limit takes part: a joint strictly
+// inside its limits is free for the whole step and may overshoot, and one at or past a limit is
+// held there with no velocity bias while the position pass pulls it back only to b2_angularSlop
+// (0.035 rad) past the limit. A motor-held joint therefore rests 0.026-0.033 rad past its limit,
+// outside the limits that the water push tests. 2.4.1 instead solves a limit speculatively, so the
+// joint stops at the limit (within 0.0005 rad) and reads inside on many held steps: pinned fish
+// fins kept pushing and the sine-gait fish swam backwards. Enabling a limit only while the joint is
+// at or past it gives back 2.3's rule through 2.4.1's public API: 2.4.1's limit pass with the angle
+// past the limit has no bias, and its position pass is 2.3's. Every limited joint of these envs has
+// lower < upper; a joint without a limit keeps lower = upper = 0 and is left alone. Limits closer
+// than 2 b2_angularSlop stay on, as 2.3 holds such a joint at all times.
+inline void box2d23_limits(b2World& world) {
+  for (b2Joint* j = world.GetJointList(); j; j = j->GetNext()) {
+    if (j->GetType() != e_revoluteJoint) continue;
+    auto* joint = static_cast<b2RevoluteJoint*>(j);
+    const float lower = joint->GetLowerLimit(), upper = joint->GetUpperLimit();
+    if (!(lower < upper)) continue;
+    const float angle = joint->GetJointAngle();
+    joint->EnableLimit(upper - lower < 2.0f * b2_angularSlop || angle <= lower || angle >= upper);
+  }
 }
 
 }  // namespace cradle::tma

@@ -74,7 +74,7 @@ void build_stump_tracks(b2World& world, const StumpTask& task, double startpad, 
   xs = {0.0};
   ys = {kTerrainHeight};
   double y = kTerrainHeight, velocity = 0.0;
-  for (double x = pad, width = kTerrainStep; x < end; x += width + spacing) {
+  for (double x = pad, width = kTerrainStep; x < end; x += spacing) {
     // Draws per stump: height, then width, then rotation (each only when its dimension is set).
     const double height = std::max(0.05, normal(rng, task.stump_height, 0.1)) * kTerrainStep;
     width = task.stump_width
@@ -99,12 +99,15 @@ void build_stump_tracks(b2World& world, const StumpTask& task, double startpad, 
     scene.bodies.push_back(polygon(world, tags.stump, b2_staticBody, poly, 0.0, kFriction, false));
     xs.push_back(x);
     ys.push_back(y);
+    // The reference's loop ends where a stump reaches the end: no gap after the last one.
+    x += width;
+    if (x >= end) break;
     // The gap: the ground's vertical velocity relaxes towards TERRAIN_HEIGHT, plus roughness noise
     // (no draw at roughness 0, so the default stream stays the benchmark's).
     velocity = 0.8 * velocity + 0.01 * ((kTerrainHeight > y) - (kTerrainHeight < y));
     if (task.roughness > 0) velocity += rng.uniform(-task.roughness, task.roughness) / kScale;
     y += velocity;
-    xs.push_back(x + width);
+    xs.push_back(x);
     ys.push_back(y);
   }
   for (size_t i = 0; i + 1 < xs.size(); ++i) {

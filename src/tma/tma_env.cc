@@ -181,12 +181,12 @@ double TmaEnv::finish_x() const {
                                              : (kTerrainLength + startpad_ - 5) * kTerrainStep;
 }
 
-b2Vec2 TmaEnv::spawn() const {
+WorldPoint TmaEnv::spawn() const {
   const double x = kTerrainStep * startpad_ / 2;
   const double y = options_.env == EnvId::kStumpTracks && body_->old_morphology
                        ? kTerrainHeight + 2 * body_->leg_h
                        : kTerrainHeight + body_->center_height;
-  return at(x, y);
+  return WorldPoint{x, y};
 }
 
 std::span<const double> TmaEnv::reset(std::optional<std::uint64_t> seed) {
@@ -214,7 +214,7 @@ std::span<const double> TmaEnv::reset(std::optional<std::uint64_t> seed) {
   }
   make_clouds(rng_, scene_);
   const double force = rng_.uniform(-5, 5);
-  const b2Vec2 p = spawn();
+  const WorldPoint p = spawn();
   build_agent(options_.body, *world_, p.x, p.y, body_->kind == BodyKind::kSwimmer ? 0.0 : force,
               /*stump_tracks=*/!parkour, agent_);
   const int n_actions = agent_.action_size();
@@ -281,6 +281,7 @@ TmaStep TmaEnv::step_raw(const double* action) {
 
   agent_.activate_motors(action_);
   if (climber) climbing_before_step(*world_, agent_, action_.data() + agent_.motors.size());
+  box2d23_limits(*world_);
   world_->Step(static_cast<float>(1.0 / kFps), kVelocityIterations, kPositionIterations);
   if (climber) climbing_after_step(*world_, agent_);
   if (parkour) apply_water_forces(listener_.water_pairs, world_->GetGravity(), water_);

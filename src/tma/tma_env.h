@@ -91,8 +91,9 @@ class TmaEnv {
   int steps_under_water() const { return under_water_; }
   int steps_outside_water() const { return outside_water_; }
   double finish_x() const;
-  // The spawn point of the agent (before a body's own offset).
-  b2Vec2 spawn() const;
+  // The spawn point of the agent (before a body's own offset), unrounded: every part is placed
+  // from it and rounded to Box2D's floats only at the end, as the reference does.
+  WorldPoint spawn() const;
 
  private:
   TmaStep step_raw(const double* action);

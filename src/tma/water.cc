@@ -3,20 +3,28 @@
 #include <algorithm>
 #include <cmath>
 
+#include "tma/physics.h"
+
 namespace cradle::tma {
 namespace {
 
 constexpr int kMaxPoints = 32;
 
+// The clipping runs in doubles on the float vertices, as the reference's Python does: the water
+// polygon spans the whole terrain (x up to ~100, y down to -100), so in floats the cross products
+// of its corners would lose the body's scale to cancellation.
 bool inside(const b2Vec2& c1, const b2Vec2& c2, const b2Vec2& p) {
-  return (c2.x - c1.x) * (p.y - c1.y) > (c2.y - c1.y) * (p.x - c1.x);
+  return (double{c2.x} - c1.x) * (double{p.y} - c1.y) >
+         (double{c2.y} - c1.y) * (double{p.x} - c1.x);
 }
 
 b2Vec2 intersection(const b2Vec2& c1, const b2Vec2& c2, const b2Vec2& s, const b2Vec2& e) {
+  // The edge directions are stored as Box2D vectors (floats) in the reference; the rest is double.
   const b2Vec2 dc = c1 - c2, dp = s - e;
-  const float n1 = b2Cross(c1, c2), n2 = b2Cross(s, e);
-  const float n3 = 1.0f / (dc.x * dp.y - dc.y * dp.x);
-  return b2Vec2((n1 * dp.x - n2 * dc.x) * n3, (n1 * dp.y - n2 * dc.y) * n3);
+  const double n1 = double{c1.x} * c2.y - double{c1.y} * c2.x;
+  const double n2 = double{s.x} * e.y - double{s.y} * e.x;
+  const double n3 = 1.0 / (double{dc.x} * dp.y - double{dc.y} * dp.x);
+  return at((n1 * dp.x - n2 * dc.x) * n3, (n1 * dp.y - n2 * dc.y) * n3);
 }
 
 // World-space vertices of a polygon fixture (counter-clockwise, as Box2D stores them).
@@ -56,17 +64,22 @@ int clip_polygon(const b2Vec2* subject, int n_subject, const b2Vec2* clip, int n
   return n;
 }
 
-float polygon_area_centroid(const b2Vec2* poly, int n, b2Vec2* centroid) {
-  float area = 0;
+double polygon_area_centroid(const b2Vec2* poly, int n, b2Vec2* centroid) {
+  // Float cross products and vector sums, the area summed in double (the reference's mix).
+  double area = 0;
   b2Vec2 c(0, 0);
   for (int i = 0; i < n; ++i) {
     const b2Vec2& p1 = poly[i];
     const b2Vec2& p2 = poly[(i + 1) % n];
-    const float a = 0.5f * b2Cross(p1, p2);
+    const double a = 0.5 * b2Cross(p1, p2);
     area += a;
-    c += a * (1.0f / 3.0f) * (p1 + p2);
+    c += static_cast<float>(a * (1.0 / 3.0)) * (p1 + p2);
   }
-  if (area != 0) c *= 1.0f / area;
+  if (area > b2_epsilon) {
+    c *= static_cast<float>(1.0 / area);
+  } else {
+    area = 0;
+  }
   *centroid = c;
   return area;
 }
@@ -84,11 +97,11 @@ void apply_water_forces(const std::vector<std::pair<b2Fixture*, b2Fixture*>>& pa
     const int n = clip_polygon(water_poly, nw, body_poly, nb, wet, kMaxPoints);
     if (n == 0) continue;
     b2Vec2 centroid;
-    const float area = polygon_area_centroid(wet, n, &centroid);
-    if (area <= b2_epsilon) continue;
+    const double area = polygon_area_centroid(wet, n, &centroid);
 
-    // Buoyancy: the weight of the displaced water, at the submerged centroid.
-    body->ApplyForce(-density * area * gravity, centroid, true);
+    // Buoyancy: the weight of the displaced water, at the submerged centroid. A sliver (area at
+    // most b2_epsilon) displaces nothing but still gets drag, lift and push below.
+    body->ApplyForce(static_cast<float>(density * area) * -gravity, centroid, true);
 
     for (int i = 0; i < n; ++i) {
       const b2Vec2 v0 = wet[i], v1 = wet[(i + 1) % n];
@@ -107,12 +120,14 @@ void apply_water_forces(const std::vector<std::pair<b2Fixture*, b2Fixture*>>& pa
             static_cast<float>(params.max_drag));
         body->ApplyForce(-drag * vel, mid, true);
         const float lift_dot = b2Dot(edge, vel);
-        const float lift = std::min(static_cast<float>(drag_dot * lift_dot * params.lift_mod *
-                                                       length * density * speed * speed),
-                                    static_cast<float>(params.max_lift));
+        const float lift =
+            std::min(static_cast<float>(double{drag_dot} * lift_dot * params.lift_mod * length *
+                                        density * speed * speed),
+                     static_cast<float>(params.max_lift));
         body->ApplyForce(lift * b2Cross(1.0f, vel), mid, true);
       }
-      // Push: joints whose bodyB is this body, strictly inside their limits, shove the water.
+      // Push: joints whose bodyB is this body, strictly inside their limits, shove the water. A
+      // joint held at a limit rests past it (box2d23_limits), so a pinned part does not push.
       for (b2JointEdge* je = body->GetJointList(); je; je = je->next) {
         b2Joint* j = je->joint;
         if (j->GetBodyB() != body || j->GetType() != e_revoluteJoint) continue;
@@ -120,12 +135,12 @@ void apply_water_forces(const std::vector<std::pair<b2Fixture*, b2Fixture*>>& pa
         const float angle = rj->GetJointAngle();
         if (!(rj->GetLowerLimit() < angle && angle < rj->GetUpperLimit())) continue;
         const float torque = rj->GetMotorTorque(60.0f);
-        const float momentum = body->GetInertia() * body->GetAngularVelocity();
+        const double momentum = double{body->GetInertia()} * body->GetAngularVelocity();
         const b2Vec2 lever = body->GetWorldCenter() - rj->GetAnchorB();
         const b2Vec2 at_center = b2Cross(lever, -torque);
         const float push_dot = b2Dot(normal, at_center);
         if (push_dot <= 0) continue;
-        const float v = torque + momentum;
+        const double v = torque + momentum;
         const float magnitude =
             static_cast<float>(push_dot * params.push_mod * length * density * v * v);
         const float clip = static_cast<float>(params.max_push);

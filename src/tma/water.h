@@ -22,7 +22,8 @@ void apply_water_forces(const std::vector<std::pair<b2Fixture*, b2Fixture*>>& pa
 // on a clip edge count as outside). Writes at most `capacity` points; returns the count.
 int clip_polygon(const b2Vec2* subject, int n_subject, const b2Vec2* clip, int n_clip, b2Vec2* out,
                  int capacity);
-// Area and centroid of a polygon by a triangle fan about the origin.
-float polygon_area_centroid(const b2Vec2* poly, int n, b2Vec2* centroid);
+// Area and centroid of a polygon by a triangle fan about the origin. An area of at most
+// b2_epsilon reads 0 and leaves the centroid unnormalised (the reference's rule).
+double polygon_area_centroid(const b2Vec2* poly, int n, b2Vec2* centroid);
 
 }  // namespace cradle::tma
