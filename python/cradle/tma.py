@@ -14,6 +14,7 @@ the TeachMyAgent README example runs with ``from cradle.tma import gym``.
 """
 
 import numbers
+import os
 import sys
 import types
 
@@ -31,6 +32,28 @@ LIDAR_TYPES = ("down", "up", "full")
 def embodiments():
     """Every embodiment name (the seed's ten, then classic_bipedal)."""
     return list(_cradle.tma_embodiments())
+
+
+# The reference's body and Parkour constructor options (see TmaEnv), their Python types.
+_INT_OPTIONS = ("nb_of_bodies", "nb_pairs_of_legs", "nb_steps_under_water",
+                "nb_steps_outside_water", "input_CPPN_dim")
+_FLOAT_OPTIONS = ("motors_torque", "ceiling_offset", "ceiling_clip_offset")
+OPTIONS = ("motors_torque",) + _INT_OPTIONS[:4] + (
+    "CPPN_weights_path", "input_CPPN_dim", "ceiling_offset", "ceiling_clip_offset")
+
+
+def _option_text(name, value):
+    """An option's value as the text the C++ env parses; ValueError for a wrong type."""
+    if name == "CPPN_weights_path":
+        if not isinstance(value, (str, os.PathLike)):
+            raise ValueError(f"option CPPN_weights_path must be a path (got {type(value).__name__})")
+        return os.fspath(value)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.generic)):
+        kind = "an integer" if name in _INT_OPTIONS else "a number"
+        raise ValueError(f"option {name} must be {kind} (got {value!r})")
+    value = value.item() if isinstance(value, np.generic) else value
+    # repr keeps every digit of a float; the env checks ranges and integrality.
+    return repr(int(value)) if isinstance(value, numbers.Integral) else repr(float(value))
 
 
 def _task_values(name, value):
@@ -57,10 +80,20 @@ class TmaEnv:
         water_clip=20.0,
         max_episode_steps=2000,
         render_mode="rgb_array",
-        **unknown,
+        **options,
     ):
+        """``options``: the reference's body options (motors_torque; nb_of_bodies for the
+        millipede; nb_pairs_of_legs for the spider; nb_steps_under_water for walkers and
+        climbers; nb_steps_outside_water for the fish) and Parkour options (CPPN_weights_path,
+        input_CPPN_dim, ceiling_offset, ceiling_clip_offset). None keeps the default."""
+        unknown = sorted(k for k in options if k not in OPTIONS)
         if unknown:
-            raise ValueError(f"unknown TeachMyAgent option '{sorted(unknown)[0]}'")
+            accepted = ", ".join(
+                ("movable_creepers", "lidars_type", "water_clip", "max_episode_steps",
+                 "render_mode") + OPTIONS)
+            raise ValueError(
+                f"unknown TeachMyAgent option '{unknown[0]}' (expected one of: {accepted})")
+        pairs = [(k, _option_text(k, v)) for k, v in options.items() if v is not None]
         if env_id not in ENV_IDS:
             raise ValueError(f"unknown env id '{env_id}' (expected one of {', '.join(ENV_IDS)})")
         if lidars_type is not None and lidars_type not in LIDAR_TYPES:
@@ -74,13 +107,15 @@ class TmaEnv:
             bool(movable_creepers),
             float(water_clip),
             int(max_episode_steps),
+            pairs,
         )
         self.env_id = env_id
         self.render_mode = render_mode
         self.agent_body_type = agent_body_type
         self.action_space = spaces.make_box(-1.0, 1.0, (self._env.action_size,), np.float32)
+        # float32 as the reference's observation space (values computed in float64, rounded once).
         self.observation_space = spaces.make_box(
-            -np.inf, np.inf, (self._env.observation_size,), np.float64
+            -np.inf, np.inf, (self._env.observation_size,), np.float32
         )
 
     @property
@@ -91,7 +126,7 @@ class TmaEnv:
     def set_environment(self, **task):
         """Sets the task of the next reset(). Stump Tracks: stump_height, obstacle_spacing, and
         the optional stump_width=(mean, std), stump_rot=(mean, std) (radians), roughness.
-        Parkour: input_vector (3 values), water_level, creepers_width, creepers_height,
+        Parkour: input_vector (input_CPPN_dim values, 3 by default), water_level, creepers_width, creepers_height,
         creepers_spacing, terrain_cppn_scale. None leaves a parameter at its default."""
         params = [(k, _task_values(k, v)) for k, v in task.items() if v is not None]
         self._env.set_environment(params)

@@ -3,6 +3,9 @@
 //          teacher, the reference's run.py (train/tma_run.h; run folder in docs/tma_run.md);
 //   random --env stump-tracks|parkour --embodiment E [--task k=v ...] [--video out.mp4]
 //          [--steps N] [--seed S] [--png F]: one random-policy episode (return, length, success);
+//   run and random also take run.py's body and Parkour options (--motors_torque, --nb_of_bodies,
+//          --nb_pairs_of_legs, --under_water, --outside_water, --CPPN_weights_path,
+//          --input_CPPN_dim, --ceiling_offset, --ceiling_clip_offset);
 //   bench  --env ... --embodiment E|all [--steps N] [--json]: env steps/s and the ratio to the
 //          bare b2World::Step on the same world, measured in one run, plus the reset time;
 //   info   : observation / action sizes and masses of every embodiment in both envs (JSON).
@@ -11,6 +14,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -133,6 +137,52 @@ std::string source_commit() {
   return out.size() == 40 ? out : "unknown";
 }
 
+// run.py's body and Parkour options, kept as text and parsed by tma::set_option (one check for the
+// CLI and Python). run.py names the water limits --under_water and --outside_water.
+struct EnvFlags {
+  struct Flag {
+    const char* option;  // TmaOptions name
+    const char* names;   // CLI11 names
+    const char* help;
+  };
+  static constexpr Flag kFlags[] = {
+      {"motors_torque", "--motors_torque",
+       "Max motor torque at |action| = 1 (default: the body's)"},
+      {"nb_of_bodies", "--nb_of_bodies", "Millipede: segments, one pair of legs each (4)"},
+      {"nb_pairs_of_legs", "--nb_pairs_of_legs", "Spider: pairs of legs (2)"},
+      {"nb_steps_under_water", "--under_water,--nb_steps_under_water",
+       "Walkers, climbers: steps under water before drowning (600)"},
+      {"nb_steps_outside_water", "--outside_water,--nb_steps_outside_water",
+       "Fish: steps out of water before stranding (600)"},
+      {"CPPN_weights_path", "--CPPN_weights_path",
+       "Parkour: CPPN weights, a raw float32 file or a TensorFlow checkpoint prefix"},
+      {"input_CPPN_dim", "--input_CPPN_dim", "Parkour: the CPPN's input dimension (3)"},
+      {"ceiling_offset", "--ceiling_offset",
+       "Parkour: ceiling height above the start pad, in CPPN units (200)"},
+      {"ceiling_clip_offset", "--ceiling_clip_offset",
+       "Parkour: least ceiling height above the ground, in CPPN units (0)"},
+  };
+  std::map<std::string, std::string> text;
+  std::vector<std::pair<std::string, const CLI::Option*>> given;
+
+  void add(CLI::App* cmd) {
+    for (const Flag& f : kFlags)
+      given.emplace_back(f.option, cmd->add_option(f.names, text[f.option], f.help));
+  }
+  void apply(tma::TmaOptions& o) const {
+    for (const auto& [name, option] : given) {
+      if (option->count() > 0) tma::set_option(o, name, text.at(name));
+    }
+  }
+  nlohmann::json arguments() const {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [name, option] : given) {
+      if (option->count() > 0) out[name] = text.at(name);
+    }
+    return out;
+  }
+};
+
 struct RunOptions {
   std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
   std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
@@ -142,13 +192,15 @@ struct RunOptions {
   int nb_test_episodes = 100;
   std::uint64_t seed = 0;
   bool shuffle_dimensions = false, scale_reward = false, resume = false, no_progress = false;
+  EnvFlags env_flags;
 };
 
 // The env family's half of a student run: envs, bounds, test set and benchmark facts.
 train::StudentEnv tma_student_env(const RunOptions& ro) {
   const tma::EnvId id = tma::parse_env_id(ro.env);
-  const tma::TmaOptions options{.env = id, .body = ro.body};
-  const tma::TmaEnv probe(options);  // refuses an unknown embodiment now
+  tma::TmaOptions options{.env = id, .body = ro.body};
+  ro.env_flags.apply(options);
+  const tma::TmaEnv probe(options);  // refuses an unknown embodiment or option now
   using J = nlohmann::ordered_json;
   // Stump Tracks: the criteria's 2-D space (spec §5); Parkour: the benchmark's (spec §3.2).
   J bounds;
@@ -160,6 +212,12 @@ train::StudentEnv tma_student_env(const RunOptions& ro) {
         "input_vector": [[-0.35, 0.05], [0.6, 1.0], [-0.1, 0.3]], "water_level": [0, 1],
         "creepers_width": [0.25, 0.25], "creepers_height": [0, 4], "creepers_spacing": [0, 5],
         "terrain_cppn_scale": [10, 10]})");
+    // Another CPPN input size: run.py's unbounded input space, [-1, 1] per input.
+    if (options.input_cppn_dim != 3) {
+      bounds["input_vector"] = J::array();
+      for (int k = 0; k < options.input_cppn_dim; ++k)
+        bounds["input_vector"].push_back({-1.0, 1.0});
+    }
   }
   train::StudentEnv env{
       .make = [options] { return std::make_unique<envs::TmaEnvAdapter>(options); },
@@ -198,10 +256,12 @@ void register_tma(CLI::App& app) {
     int steps = tma::kMaxEpisodeSteps;
     std::uint64_t seed = 0;
     bool movable_creepers = false, lidars = false;
+    EnvFlags env_flags;
   };
   auto ro = std::make_shared<RandomOptions>();
   CLI::App* random = tma_cmd->add_subcommand("random", "One random-policy episode");
   add_env_options(random, ro->env, ro->body);
+  ro->env_flags.add(random);
   random->add_option("--task", ro->tasks, "Task parameter name=value[,v2,v3] (repeatable)");
   random->add_option("--video", ro->video, "Write the episode to this .mp4 / .avi");
   random->add_option("--steps", ro->steps, "Episode step cap")->check(CLI::Range(1, 1000000));
@@ -212,10 +272,12 @@ void register_tma(CLI::App& app) {
   random->add_option("--png-step", ro->png_step, "Step of the --png frame (or the last step)")
       ->check(CLI::Range(0, 1000000));
   random->callback([ro] {
-    tma::TmaEnv env(tma::TmaOptions{.env = tma::parse_env_id(ro->env),
-                                    .body = ro->body,
-                                    .movable_creepers = ro->movable_creepers,
-                                    .max_episode_steps = ro->steps});
+    tma::TmaOptions options{.env = tma::parse_env_id(ro->env),
+                            .body = ro->body,
+                            .movable_creepers = ro->movable_creepers,
+                            .max_episode_steps = ro->steps};
+    ro->env_flags.apply(options);
+    tma::TmaEnv env(options);
     std::vector<tma::TaskParam> params;
     for (const std::string& t : ro->tasks) params.push_back(parse_task(t));
     env.set_environment(params);
@@ -302,6 +364,7 @@ void register_tma(CLI::App& app) {
   CLI::App* run = tma_cmd->add_subcommand("run", "Train a student with a teacher (run.py)");
   run->add_option("--exp_name", rn->exp_name, "Experiment name (default run folder)");
   add_env_options(run, rn->env, rn->body);
+  rn->env_flags.add(run);
   run->add_option("--student", rn->student, "sac | ppo (the reference presets)");
   run->add_option("--teacher", rn->teacher,
                   "Random, ADR, ALP-GMM, Covar-GMM, RIAC, Self-Paced, GoalGAN, Setter-Solver");
@@ -383,6 +446,10 @@ void register_tma(CLI::App& app) {
                    {"hp", ro.hp},
                    {"out", o.out.string()},
                    {"resume", ro.resume}};
+    // Only when given, so that runs without them resume as before.
+    if (const nlohmann::json env_options = ro.env_flags.arguments(); !env_options.empty()) {
+      o.arguments["env_options"] = env_options;
+    }
     o.commit = source_commit();
     // Ctrl-C or a scheduler's SIGTERM ends the run at its next report instead of killing it.
     o.stop = stop_on({SIGINT, SIGTERM});

@@ -720,8 +720,12 @@ void video(const VideoOptions& o) {
   learn::LearnerOptions lo;
   lo.hyperparameters = learn::parse_hyperparameter_text(info.config);
   if (lo.hyperparameters.count("buffer_size")) lo.hyperparameters["buffer_size"] = "1000";
-  const tma::TmaOptions options{
+  tma::TmaOptions options{
       .env = tma::parse_env_id(env_name), .body = body, .max_episode_steps = o.steps};
+  // The run's body and Parkour options (`tma run --motors_torque ...`), as given.
+  for (const auto& [name, value] : args.value("env_options", nlohmann::json::object()).items()) {
+    tma::set_option(options, name, value.get<std::string>());
+  }
   learn::ThreadedVecEnv vec(
       1, [&](int) { return std::make_unique<envs::TmaEnvAdapter>(options); }, 1);
   std::unique_ptr<learn::Learner> learner = learn::make_learner(info.algorithm, vec, lo);

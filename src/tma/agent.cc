@@ -121,10 +121,11 @@ const Embodiment& embodiment(std::string_view name) {
 }
 
 void build_agent(std::string_view name, b2World& world, double x0, double y0, double force,
-                 bool stump_tracks, Agent& agent) {
+                 bool stump_tracks, Agent& agent, const BodyOptions& options) {
   const Embodiment& e = embodiment(name);
   agent = Agent{};
   agent.kind = e.kind;
+  agent.options = options;
   const double y = y0 + e.spawn_dy;
   e.build(agent, world, x0, y, stump_tracks);
   // The initial push acts during the first world step only (Box2D clears forces after a step).

@@ -32,8 +32,16 @@ struct Sensor {
   b2Joint* grasp = nullptr;       // the revolute joint holding the grip, if any
 };
 
+// Build options of the reference bodies that change their shape (TmaOptions checks which body
+// takes which).
+struct BodyOptions {
+  int nb_of_bodies = 4;      // millipede segments
+  int nb_pairs_of_legs = 2;  // spider
+};
+
 struct Agent {
   BodyKind kind = BodyKind::kWalker;
+  BodyOptions options;             // what the builder reads
   double torque = 80;              // MOTORS_TORQUE
   double torque_penalty = 3.5e-4;  // TORQUE_PENALTY
   bool remove_head_angle = false;  // reward without the head-angle term
@@ -77,7 +85,7 @@ const Embodiment& embodiment(std::string_view name);
 // Builds `name` with its origin at (x0, y0) (before spawn_dy), pushing its head with `force`.
 // `stump_tracks` makes walker hulls critical (reset_on_hull_critical_contact).
 void build_agent(std::string_view name, b2World& world, double x0, double y0, double force,
-                 bool stump_tracks, Agent& agent);
+                 bool stump_tracks, Agent& agent, const BodyOptions& options = {});
 void destroy_agent(b2World& world, Agent& agent);
 
 // Builders shared by the family files.

@@ -119,10 +119,12 @@ void build_stump_tracks(b2World& world, const StumpTask& task, double startpad, 
 }
 
 void build_parkour(b2World& world, const ParkourTask& task, const Cppn& cppn, double startpad,
-                   bool movable_creepers, Rng& rng, TerrainTags& tags, Scene& scene) {
+                   bool movable_creepers, Rng& rng, TerrainTags& tags, Scene& scene,
+                   double ceiling_offset, double ceiling_clip_offset) {
   scene = Scene{};
   const double scale = task.terrain_cppn_scale;
-  scene.ceiling_offset = 200.0 / scale;
+  scene.ceiling_offset = ceiling_offset / scale;
+  const double clip_offset = ceiling_clip_offset / scale;
   scene.ground_limit = -1000.0 / scale;
   const double ceiling_limit = 1000.0 / scale;
   // CPPN rows: ground and ceiling divided by the scale and aligned to the start pad.
@@ -143,7 +145,7 @@ void build_parkour(b2World& world, const ParkourTask& task, const Cppn& cppn, do
       const double g = y[2 * (i - pad)] / scale - g0 + kTerrainHeight;
       const double c = y[2 * (i - pad) + 1] / scale - c0 + kTerrainHeight + scene.ceiling_offset;
       scene.ground[i] = g;
-      scene.ceiling[i] = std::max(c, g);  // ceiling clipped to the ground (clip offset 0)
+      scene.ceiling[i] = std::max(c, g + clip_offset);  // at least clip_offset above the ground
     }
   }
   // Per edge: ground, ceiling, then a creeper when the spacing accumulator allows one.

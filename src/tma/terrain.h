@@ -29,7 +29,7 @@ struct StumpTask {
 
 // Parkour task (the 8-D task vector of the benchmark).
 struct ParkourTask {
-  std::array<double, 3> input_vector{0, 0, 0};
+  std::vector<double> input_vector{0, 0, 0};  // the CPPN's input dimension (3) values
   double water_level = 0.0;  // floored at 0.01
   std::optional<double> creepers_width, creepers_height;
   double creepers_spacing = 0.1;  // floored at 0.01
@@ -61,7 +61,7 @@ struct Scene {
   std::vector<double> xs, ground, ceiling;  // terrain points (Parkour ceiling; empty otherwise)
   b2Body* water = nullptr;
   double water_y = -1e9;      // no water in Stump Tracks
-  double ceiling_offset = 0;  // Parkour: 200 / scale
+  double ceiling_offset = 0;  // Parkour: ceiling_offset / scale (200 / scale by default)
   double ground_limit = 0;    // Parkour: -1000 / scale
 };
 
@@ -69,8 +69,11 @@ double normal(Rng& rng, double mean, double std);
 
 void build_stump_tracks(b2World& world, const StumpTask& task, double startpad, Rng& rng,
                         TerrainTags& tags, Scene& scene);
+// The ceiling starts `ceiling_offset` above the start pad and stays at least `ceiling_clip_offset`
+// above it (both in CPPN units, divided by the task's terrain_cppn_scale).
 void build_parkour(b2World& world, const ParkourTask& task, const Cppn& cppn, double startpad,
-                   bool movable_creepers, Rng& rng, TerrainTags& tags, Scene& scene);
+                   bool movable_creepers, Rng& rng, TerrainTags& tags, Scene& scene,
+                   double ceiling_offset = 200, double ceiling_clip_offset = 0);
 // Ten five-point clouds (rendering only), 110 draws as in the reference.
 void make_clouds(Rng& rng, Scene& scene);
 

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -52,9 +55,97 @@ EnvId parse_env_id(std::string_view name) {
 
 std::string_view env_id_name(EnvId id) { return id == EnvId::kStumpTracks ? kStumpId : kParkourId; }
 
+const std::vector<std::string>& option_names() {
+  static const std::vector<std::string> names = {
+      "motors_torque",          "nb_of_bodies",      "nb_pairs_of_legs", "nb_steps_under_water",
+      "nb_steps_outside_water", "CPPN_weights_path", "input_CPPN_dim",   "ceiling_offset",
+      "ceiling_clip_offset",    "lidars_type",       "water_clip",       "movable_creepers"};
+  return names;
+}
+
+namespace {
+
+// A finite number, or a one-line error naming the option and what it takes.
+double number_option(std::string_view name, std::string_view text, const std::string& expected) {
+  const std::string s(text);
+  double v = 0;
+  try {
+    size_t used = 0;
+    v = std::stod(s, &used);
+    if (used != s.size()) throw std::invalid_argument(s);
+  } catch (const std::exception&) {
+    throw UserError("option " + std::string(name) + " = '" + s + "' is not a number (expected " +
+                    expected + ")");
+  }
+  if (!std::isfinite(v)) {
+    throw UserError("option " + std::string(name) + " = " + s + " (expected " + expected + ")");
+  }
+  return v;
+}
+
+// An integer within [lo, hi]; an integral float ("600.0", as the reference's run.py parses these
+// flags) is accepted.
+int int_option(std::string_view name, std::string_view text, int lo, int hi) {
+  const std::string expected =
+      "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const double v = number_option(name, text, expected);
+  if (v != std::floor(v) || v < lo || v > hi) {
+    throw UserError("option " + std::string(name) + " = " + std::string(text) + " (expected " +
+                    expected + ")");
+  }
+  return static_cast<int>(v);
+}
+
+}  // namespace
+
+void set_option(TmaOptions& o, std::string_view name, std::string_view value) {
+  constexpr int kMaxSteps = 1000000000;
+  if (name == "motors_torque") {
+    const double v = number_option(name, value, "a finite torque >= 0");
+    if (v < 0) throw UserError("option motors_torque = " + std::string(value) + " (expected >= 0)");
+    o.motors_torque = v;
+  } else if (name == "nb_of_bodies") {
+    o.nb_of_bodies = int_option(name, value, 1, 100);
+  } else if (name == "nb_pairs_of_legs") {
+    o.nb_pairs_of_legs = int_option(name, value, 1, 50);
+  } else if (name == "nb_steps_under_water") {
+    o.nb_steps_under_water = int_option(name, value, 0, kMaxSteps);
+  } else if (name == "nb_steps_outside_water") {
+    o.nb_steps_outside_water = int_option(name, value, 0, kMaxSteps);
+  } else if (name == "CPPN_weights_path") {
+    if (value.empty()) throw UserError("option CPPN_weights_path is empty (expected a file path)");
+    o.cppn_weights_path = std::string(value);
+  } else if (name == "input_CPPN_dim") {
+    o.input_cppn_dim = int_option(name, value, 1, 64);
+  } else if (name == "ceiling_offset") {
+    o.ceiling_offset = number_option(name, value, "a finite number");
+  } else if (name == "ceiling_clip_offset") {
+    o.ceiling_clip_offset = number_option(name, value, "a finite number");
+  } else if (name == "lidars_type") {
+    o.lidars = std::string(value);  // checked with the body (down, up or full)
+  } else if (name == "water_clip") {
+    o.water_clip = number_option(name, value, "a finite positive number");
+  } else if (name == "movable_creepers") {
+    if (value == "true" || value == "True" || value == "1") {
+      o.movable_creepers = true;
+    } else if (value == "false" || value == "False" || value == "0") {
+      o.movable_creepers = false;
+    } else {
+      throw UserError("option movable_creepers = '" + std::string(value) +
+                      "' (expected true or false)");
+    }
+  } else {
+    std::string known;
+    for (const std::string& n : option_names()) known += (known.empty() ? "" : ", ") + n;
+    throw UserError("unknown TeachMyAgent option '" + std::string(name) +
+                    "' (expected one of: " + known + ")");
+  }
+}
+
 TmaEnv::TmaEnv(const TmaOptions& options, std::shared_ptr<const Cppn> cppn)
     : options_(options), cppn_(std::move(cppn)) {
   body_ = &embodiment(options_.body);
+  check_body_options();
   if (options_.max_episode_steps < 1) {
     throw UserError("max_episode_steps = " + std::to_string(options_.max_episode_steps) +
                     " (expected >= 1)");
@@ -81,10 +172,26 @@ TmaEnv::TmaEnv(const TmaOptions& options, std::shared_ptr<const Cppn> cppn)
   } else {
     throw UserError("unknown lidar type '" + lidars + "' (expected down, up or full)");
   }
-  startpad_ = std::max<double>(kStartpad, body_->width / kTerrainStep + 5);
+  // The millipede is as wide as its segments (20 px each); every other body has a fixed width.
+  const double width =
+      body_->name == "millipede" ? 20 / kScale * options_.nb_of_bodies.value_or(4) : body_->width;
+  startpad_ = std::max<double>(kStartpad, width / kTerrainStep + 5);
   if (parkour && !cppn_) {
-    cppn_ = std::make_shared<const Cppn>(data_dir() / "ground_ceiling_cppn.f32", 2);
+    if (options_.cppn_weights_path.empty() && options_.input_cppn_dim != 3) {
+      throw UserError("input_CPPN_dim = " + std::to_string(options_.input_cppn_dim) +
+                      " needs CPPN_weights_path (the shipped CPPN takes 3 inputs)");
+    }
+    cppn_ = std::make_shared<const Cppn>(options_.cppn_weights_path.empty()
+                                             ? data_dir() / "ground_ceiling_cppn.f32"
+                                             : std::filesystem::path(options_.cppn_weights_path),
+                                         2, options_.input_cppn_dim);
   }
+  if (parkour && cppn_->inputs() != options_.input_cppn_dim) {
+    throw UserError(
+        "the CPPN takes " + std::to_string(cppn_->inputs()) +
+        " inputs (expected input_CPPN_dim = " + std::to_string(options_.input_cppn_dim) + ")");
+  }
+  parkour_task_.input_vector.assign(options_.input_cppn_dim, 0.0);
   reset(0);
   action_size_ = agent_.action_size();
 }
@@ -93,6 +200,42 @@ TmaEnv::~TmaEnv() {
   // The world goes first: its destructor must not call back into a half-destroyed env.
   if (world_) world_->SetContactListener(nullptr);
   world_.reset();
+}
+
+void TmaEnv::check_body_options() {
+  const std::string& body = options_.body;
+  const BodyKind kind = body_->kind;
+  auto refuse = [&](const char* option, const std::string& takes) {
+    throw UserError("option " + std::string(option) + " does not apply to " + body + " (" + takes +
+                    ")");
+  };
+  if (options_.nb_of_bodies && body != "millipede") refuse("nb_of_bodies", "millipede only");
+  if (options_.nb_pairs_of_legs && body != "spider") refuse("nb_pairs_of_legs", "spider only");
+  if (options_.nb_steps_under_water && kind != BodyKind::kWalker && kind != BodyKind::kClimber) {
+    refuse("nb_steps_under_water", "walkers and climbers only");
+  }
+  if (options_.nb_steps_outside_water && kind != BodyKind::kSwimmer) {
+    refuse("nb_steps_outside_water", "swimmers (fish) only");
+  }
+  if (options_.motors_torque &&
+      !(std::isfinite(*options_.motors_torque) && *options_.motors_torque >= 0)) {
+    throw UserError("option motors_torque must be a finite torque >= 0");
+  }
+  if (options_.env == EnvId::kStumpTracks) {
+    // The Stump Tracks env has no CPPN nor ceiling (the reference's constructor refuses them).
+    if (!options_.cppn_weights_path.empty()) refuse("CPPN_weights_path", "Parkour only");
+    if (options_.input_cppn_dim != 3) refuse("input_CPPN_dim", "Parkour only");
+    if (options_.ceiling_offset != 200) refuse("ceiling_offset", "Parkour only");
+    if (options_.ceiling_clip_offset != 0) refuse("ceiling_clip_offset", "Parkour only");
+  }
+  if (!std::isfinite(options_.ceiling_offset) || !std::isfinite(options_.ceiling_clip_offset)) {
+    throw UserError("options ceiling_offset and ceiling_clip_offset must be finite numbers");
+  }
+  if (kind == BodyKind::kWalker || kind == BodyKind::kClimber) {
+    under_water_limit_ = options_.nb_steps_under_water.value_or(kSurviveSteps);
+  } else if (kind == BodyKind::kSwimmer) {
+    outside_water_limit_ = options_.nb_steps_outside_water.value_or(kSurviveSteps);
+  }
 }
 
 void TmaEnv::set_stump_task(const StumpTask& task) {
@@ -111,6 +254,11 @@ void TmaEnv::set_stump_task(const StumpTask& task) {
 }
 
 void TmaEnv::set_parkour_task(const ParkourTask& task) {
+  if (static_cast<int>(task.input_vector.size()) != options_.input_cppn_dim) {
+    throw UserError("task parameter input_vector takes " + std::to_string(options_.input_cppn_dim) +
+                    " values (got " + std::to_string(task.input_vector.size()) +
+                    "; input_CPPN_dim sets the size)");
+  }
   for (double v : task.input_vector) checked("input_vector", v, -1, 1);
   checked("water_level", task.water_level, 0, 1);
   if (task.creepers_width) checked("creepers_width", *task.creepers_width, 0, 5);
@@ -151,11 +299,13 @@ void TmaEnv::set_environment(const std::vector<TaskParam>& params) {
   ParkourTask task = parkour_task_;
   for (const TaskParam& p : params) {
     if (p.first == "input_vector") {
-      if (p.second.size() != 3) {
-        throw UserError("task parameter input_vector takes 3 values (got " +
-                        std::to_string(p.second.size()) + ")");
+      const int dim = options_.input_cppn_dim;
+      if (static_cast<int>(p.second.size()) != dim) {
+        throw UserError("task parameter input_vector takes " + std::to_string(dim) +
+                        " values (got " + std::to_string(p.second.size()) + ")");
       }
-      for (int k = 0; k < 3; ++k)
+      task.input_vector.resize(dim);
+      for (int k = 0; k < dim; ++k)
         task.input_vector[k] = checked("input_vector", p.second[k], -1, 1);
     } else if (p.first == "water_level") {
       task.water_level = single(p, 0, 1);
@@ -208,7 +358,7 @@ std::span<const double> TmaEnv::reset(std::optional<std::uint64_t> seed) {
   // Terrain, clouds, then the agent with its initial push.
   if (parkour) {
     build_parkour(*world_, parkour_task_, *cppn_, startpad_, options_.movable_creepers, rng_, tags_,
-                  scene_);
+                  scene_, options_.ceiling_offset, options_.ceiling_clip_offset);
   } else {
     build_stump_tracks(*world_, stump_task_, startpad_, rng_, tags_, scene_);
   }
@@ -216,7 +366,10 @@ std::span<const double> TmaEnv::reset(std::optional<std::uint64_t> seed) {
   const double force = rng_.uniform(-5, 5);
   const WorldPoint p = spawn();
   build_agent(options_.body, *world_, p.x, p.y, body_->kind == BodyKind::kSwimmer ? 0.0 : force,
-              /*stump_tracks=*/!parkour, agent_);
+              /*stump_tracks=*/!parkour, agent_,
+              BodyOptions{.nb_of_bodies = options_.nb_of_bodies.value_or(4),
+                          .nb_pairs_of_legs = options_.nb_pairs_of_legs.value_or(2)});
+  if (options_.motors_torque) agent_.torque = *options_.motors_torque;
   const int n_actions = agent_.action_size();
   obs_.assign((parkour ? 6 + 2 * kLidars : 4 + kLidars) + agent_.state_size(), 0.0);
   action_.assign(n_actions, 0.0);
@@ -272,9 +425,8 @@ TmaStep TmaEnv::step_raw(const double* action) {
   const bool parkour = options_.env == EnvId::kParkour;
   const bool climber = agent_.kind == BodyKind::kClimber;
   // A drowned walker / climber or a stranded fish stops acting (permanently: counters freeze).
-  const bool dead =
-      parkour && ((agent_.kind == BodyKind::kSwimmer && outside_water_ > kSurviveSteps) ||
-                  ((agent_.kind == BodyKind::kWalker || climber) && under_water_ > kSurviveSteps));
+  const bool dead = parkour && ((outside_water_limit_ && outside_water_ > *outside_water_limit_) ||
+                                (under_water_limit_ && under_water_ > *under_water_limit_));
   dead_ = dead;
   const int n = static_cast<int>(action_.size());
   for (int i = 0; i < n; ++i) action_[i] = dead ? 0.0 : action[i];

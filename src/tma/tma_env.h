@@ -38,7 +38,31 @@ struct TmaOptions {
   bool movable_creepers = false;  // Parkour
   double water_clip = 20;         // Parkour: max push force per component
   int max_episode_steps = kMaxEpisodeSteps;
+  // The reference bodies' constructor arguments; unset keeps the body's own default. A body that
+  // has no such argument refuses it (the reference raises a TypeError).
+  std::optional<double> motors_torque;        // every body: max motor torque at |action| = 1
+  std::optional<int> nb_of_bodies;            // millipede: segments, one pair of legs each (4)
+  std::optional<int> nb_pairs_of_legs;        // spider (2)
+  std::optional<int> nb_steps_under_water;    // walkers, climbers: steps before drowning (600)
+  std::optional<int> nb_steps_outside_water;  // fish: steps before stranding (600)
+  // Parkour's terrain: a user's CPPN weights (Cradle's raw float32 file, or the reference's
+  // TensorFlow checkpoint prefix; empty: the shipped weights), the CPPN's input dimension (the
+  // task's input_vector size), and the ceiling's start height above the ground and its least
+  // height above the ground, both in CPPN units (divided by the task's terrain_cppn_scale).
+  std::string cppn_weights_path;
+  int input_cppn_dim = 3;
+  double ceiling_offset = 200;
+  double ceiling_clip_offset = 0;
 };
+
+// Sets one option of TmaOptions by its reference name (motors_torque, nb_of_bodies,
+// nb_pairs_of_legs, nb_steps_under_water, nb_steps_outside_water, CPPN_weights_path,
+// input_CPPN_dim, ceiling_offset, ceiling_clip_offset, lidars_type, water_clip,
+// movable_creepers) from its text. Throws cradle::UserError naming the option and what it takes
+// for a malformed value, and listing the options for an unknown name. Whether the body and env
+// take it is checked when the env is built.
+void set_option(TmaOptions& options, std::string_view name, std::string_view value);
+const std::vector<std::string>& option_names();
 
 struct TmaStep {
   double reward = 0;
@@ -52,8 +76,9 @@ using TaskParam = std::pair<std::string, std::vector<double>>;
 
 class TmaEnv {
  public:
-  // Throws cradle::UserError for an unknown body or lidar type. `cppn` may be shared by many envs;
-  // when null, Parkour loads the shipped weights.
+  // Throws cradle::UserError for an unknown body or lidar type, or an option the body or env does
+  // not take. `cppn` may be shared by many envs; when null, Parkour loads
+  // options.cppn_weights_path (or the shipped weights).
   explicit TmaEnv(const TmaOptions& options, std::shared_ptr<const Cppn> cppn = nullptr);
   ~TmaEnv();
   TmaEnv(const TmaEnv&) = delete;
@@ -96,6 +121,8 @@ class TmaEnv {
   WorldPoint spawn() const;
 
  private:
+  // Refuses options the body or env does not take; sets the water limits.
+  void check_body_options();
   TmaStep step_raw(const double* action);
   void cast_and_observe(bool dead);
 
@@ -123,6 +150,8 @@ class TmaEnv {
   int steps_ = 0;
   int under_water_ = 0, outside_water_ = 0;
   bool dead_ = false;
+  // Steps the agent may stay under / out of water before it is dead (none: it never dies).
+  std::optional<int> under_water_limit_, outside_water_limit_;
 };
 
 }  // namespace cradle::tma

@@ -173,14 +173,16 @@ void build_old_big_quadru(Agent& agent, b2World& world, double x0, double y0, bo
 }
 
 void build_spider(Agent& agent, b2World& world, double x0, double y0, bool critical_hull) {
+  const int pairs = agent.options.nb_pairs_of_legs;
   agent.torque = 100;
-  agent.torque_penalty = 3.5e-4 / 2;
+  agent.torque_penalty = 3.5e-4 / pairs;
   const double h = 10 / kScale;  // half leg length
   b2Body* main = hull(agent, world, x0, y0, square(), 5.0, critical_hull, kHull1, kHull2);
   const b2PolygonShape upper_shape = build::box(3 / kScale, h);
   const b2PolygonShape lower_shape = build::box(2.4 / kScale, h);
-  // Legs 0 and 2 (and 1 and 3) are identical and overlap; own parts never collide.
-  for (double s : {1.0, -1.0, 1.0, -1.0}) {
+  // Sides +1, -1 per pair: every pair is the same two legs, overlapping (own parts never collide).
+  for (int leg = 0; leg < 2 * pairs; ++leg) {
+    const double s = leg % 2 == 0 ? 1.0 : -1.0;
     const double a1 = 0.25 * kPi * s, a2 = 0.7 * kPi * s, a3 = 0.9 * kPi * s;
     const double ux = x0 - s / 3 - std::sin(a1) * h, uy = y0 + std::cos(a1) * h - 4 / kScale;
     b2Body* upper = build::part(agent, world, at(ux, uy), a1, upper_shape, Fixture{}, false, false,
@@ -206,7 +208,8 @@ void build_spider(Agent& agent, b2World& world, double x0, double y0, bool criti
 
 void build_millipede(Agent& agent, b2World& world, double x0, double y0) {
   agent.torque = 200;
-  const int bodies = 4;
+  // One pair of legs per segment; the torque penalty is shared out over the pairs.
+  const int bodies = agent.options.nb_of_bodies;
   agent.torque_penalty = 3.5e-4 / bodies;
   const Leg leg{.w = 4 / kScale, .h = 10 / kScale, .down = 3 / kScale};
   const double seg = 20 / kScale;

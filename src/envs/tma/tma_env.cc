@@ -7,14 +7,15 @@
 #include <vector>
 
 #include "core/error.h"
-
 #include "envs/action_check.h"
 
 namespace cradle::envs {
 namespace {
 
 DictSpace observation_space_of(const tma::TmaEnv& env) {
-  return DictSpace{{{"observation", Box::unbounded({env.observation_size()}, DType::kFloat64)}}};
+  // float32, as the reference's observation space: the env computes in float64 (its reward reads
+  // the head angle unrounded) and the observation is that rounded once.
+  return DictSpace{{{"observation", Box::unbounded({env.observation_size()}, DType::kFloat32)}}};
 }
 
 }  // namespace
@@ -77,7 +78,8 @@ StepResult TmaEnvAdapter::step(std::span<const double> action) {
 
 void TmaEnvAdapter::copy_observation() {
   const std::span<const double> obs = env_.observation();
-  std::copy(obs.begin(), obs.end(), buffers_.f64(0).begin());
+  std::ranges::transform(obs, buffers_.f32(0).begin(),
+                         [](double v) { return static_cast<float>(v); });
 }
 
 }  // namespace cradle::envs

@@ -1,6 +1,6 @@
 // cradle::envs::Env over a TeachMyAgent environment (src/tma/): one observation entry
-// "observation" (float64, unbounded), actions in [-1, 1]; Info::is_success carries `success`
-// (return > 230) and Info::is_failure a -100 termination.
+// "observation" (float32 as in the reference, unbounded), actions in [-1, 1]; Info::is_success
+// carries `success` (return > 230) and Info::is_failure a -100 termination.
 #pragma once
 
 #include <memory>
