@@ -1,12 +1,17 @@
 #include "sami/locomotion.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace cradle::sami {
 namespace {
 
 enum class Reward { kCheetah, kAnt, kHopWalk, kSlim, kStandup };
+// Where the forward term's x comes from: root x (qpos[0]) or the torso body's xpos as mj_step
+// leaves it (computed at the start of the last substep, not recomputed: gym's get_body_com).
+enum class Forward { kRootX, kTorsoXpos };
 enum class ObsForm { kVelQpos1, kVelQpos2, kCrippleAnt, kPlanar, kHumanoid };
 enum class Scaling { kAll, kAntSplit, kMassOnly };
 enum class Cripple { kNone, kJoint, kAntLeg };
@@ -16,9 +21,13 @@ struct Rules {
   Reward reward;
   ObsForm obs;
   Scaling scaling;
+  Forward forward = Forward::kRootX;
   Cripple cripple = Cripple::kNone;
-  bool shrink = false;       // crippled capsules get half radius and half length
-  double ctrl_cost = 0;      // weight of ||a||^2
+  bool shrink = false;   // crippled capsules get half radius and half length
+  double ctrl_cost = 0;  // weight of ||a||^2
+  // ||a||^2 in float32, as NumPy computes it on the reference's float32 action; the crippled
+  // envs multiply the action by a float64 mask first, so theirs is in float64.
+  bool ctrl_cost_f32 = false;
   bool uniform_pos = false;  // reset noise on qpos: uniform(+-pos_noise), else normal
   bool uniform_vel = false;  // same for qvel
   double pos_noise = 0, vel_noise = 0;
@@ -30,6 +39,7 @@ struct Rules {
 Rules crippled(Rules r, Cripple cripple, int first_geom, bool shrink = false) {
   r.scaling = Scaling::kMassOnly;
   r.cripple = cripple;
+  r.ctrl_cost_f32 = false;
   r.first_cripple_geom = first_geom;
   r.shrink = shrink;
   return r;
@@ -41,12 +51,15 @@ Rules rules(EnvId id) {
                          .obs = ObsForm::kVelQpos1,
                          .scaling = Scaling::kAll,
                          .ctrl_cost = 0.1,
+                         .ctrl_cost_f32 = true,
                          .pos_noise = 0.001,
                          .vel_noise = 0.001};
   const Rules ant = {.reward = Reward::kAnt,
                      .obs = ObsForm::kVelQpos2,
                      .scaling = Scaling::kAntSplit,
+                     .forward = Forward::kTorsoXpos,
                      .ctrl_cost = 0.01,
+                     .ctrl_cost_f32 = true,
                      .uniform_pos = true,
                      .pos_noise = 0.1,
                      .vel_noise = 0.1};
@@ -54,6 +67,7 @@ Rules rules(EnvId id) {
                         .obs = ObsForm::kPlanar,
                         .scaling = Scaling::kAll,
                         .ctrl_cost = 1e-3,
+                        .ctrl_cost_f32 = true,
                         .uniform_pos = true,
                         .uniform_vel = true,
                         .pos_noise = 0.005,
@@ -107,6 +121,36 @@ Rules rules(EnvId id) {
 constexpr int kAntLegActuators[4][2] = {{2, 3}, {4, 5}, {6, 7}, {0, 1}};
 constexpr float kRed[4] = {1, 0, 0, 1};
 
+// np.sum's order of additions (NumPy 1.x pairwise summation, `pairwise_sum` in its loops): below
+// 8 values one running sum from 0; up to 128, eight running sums combined as a tree, then the
+// rest; above, the two halves (the first a multiple of 8 long) summed apart. The reference's costs
+// are such sums, so the same order gives the same bits.
+template <class T>
+T numpy_sum(const T* x, int n) {
+  if (n < 8) {
+    T sum = 0;
+    for (int i = 0; i < n; ++i) sum += x[i];
+    return sum;
+  }
+  if (n <= 128) {
+    T r[8];
+    std::copy_n(x, 8, r);
+    int i = 8;
+    for (; i < n - n % 8; i += 8) {
+      for (int j = 0; j < 8; ++j) r[j] += x[i + j];
+    }
+    T sum = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
+    for (; i < n; ++i) sum += x[i];
+    return sum;
+  }
+  int half = n / 2;
+  half -= half % 8;
+  return numpy_sum(x, half) + numpy_sum(x + half, n - half);
+}
+
+// The most squares a cost sums: 6 x nbody cfrc_ext entries (84 for the Ant and the humanoid).
+constexpr int kMaxSquares = 6 * 32;
+
 class Locomotion final : public SamiEnv {
  public:
   Locomotion(Spec spec, ModelPtr model, std::vector<TaskSet> sets, std::uint64_t seed,
@@ -115,12 +159,18 @@ class Locomotion final : public SamiEnv {
         rules_(rules(spec_.id)),
         options_(options),
         mask_(spec_.action_size, 1.0),
-        action_(spec_.action_size, 0.0) {}
+        action_(spec_.action_size, 0.0) {
+    if (6 * model_.nbody > kMaxSquares) throw std::logic_error("locomotion: too many bodies");
+  }
 
-  void reset(std::optional<std::uint64_t> seed) override {
+  void reset_episode(std::optional<std::uint64_t> seed) override {
     const TaskSet& set = begin_reset(seed);
     const mjModel* m = &model_;
     mjData* d = data_.get();
+    // The reference writes the new parameters after set_state's mj_forward, so that forward (and
+    // the solver's warm start it leaves for the first step) still sees the last episode's
+    // parameters: put them back for it.
+    apply(last_);
     // State: qpos0 and zero velocity plus the env's noise (Ant's quaternion included).
     for (int i = 0; i < m->nq; ++i) {
       d->qpos[i] =
@@ -129,42 +179,57 @@ class Locomotion final : public SamiEnv {
     for (int i = 0; i < m->nv; ++i) {
       d->qvel[i] = (rules_.uniform_vel ? rng_.uniform(-1, 1) : normal()) * rules_.vel_noise;
     }
-    // Hidden parameters, written into the private arrays only.
-    info_.mass = pick(set.mass);
-    info_.damping = pick(set.damping);
-    scale(info_.mass, info_.damping);
-    std::fill(mask_.begin(), mask_.end(), 1.0);
+    // Hidden parameters of the new episode: drawn now (the generator's order is unchanged),
+    // written after the forward.
+    Draw draw;
+    draw.mass = pick(set.mass);
+    draw.damping = pick(set.damping);
     if (!set.cripple.empty()) {
       const std::vector<int>& choice = set.cripple[rng_.next() % set.cripple.size()];
-      info_.crippled.assign(choice.begin(), choice.end());
-      std::sort(info_.crippled.begin(), info_.crippled.end());
-      info_.masked = set.mask;
-      for (int unit : info_.crippled) cripple(unit, set.mask);
+      // validate() allows at most three units; kept ascending (a three-entry insertion sort).
+      draw.crippled = static_cast<int>(std::min<size_t>(choice.size(), draw.units.size()));
+      for (int k = 0; k < draw.crippled; ++k) {
+        int u = choice[k], p = k;
+        for (; p > 0 && draw.units[p - 1] > u; --p) draw.units[p] = draw.units[p - 1];
+        draw.units[p] = u;
+      }
+      draw.mask = set.mask;
     }
     mj_forward(m, d);
     x_before_ = forward_position();
+    restore_parameters();
+    apply(draw);
+    last_ = draw;
+    info_.mass = draw.mass;
+    info_.damping = draw.damping;
+    info_.crippled.assign(draw.units.begin(), draw.units.begin() + draw.crippled);
+    info_.masked = !set.cripple.empty() && set.mask;
     write_observation(0.0);
   }
 
-  StepResult step(std::span<const double> action) override {
+  std::span<const double> action_mask() const override { return mask_; }
+
+  StepResult step_episode(std::span<const double> action) override {
     check_action(action);
     const mjModel* m = &model_;
     mjData* d = data_.get();
-    // The mask multiplies the action; MuJoCo clamps ctrl to ctrlrange itself.
+    // The action is float32 in the reference (its action space's dtype, what its agents pass);
+    // the mask multiplies it; MuJoCo clamps ctrl to ctrlrange itself.
     for (int i = 0; i < spec_.action_size; ++i) {
-      action_[i] = action[i] * mask_[i];
+      action_[i] = static_cast<double>(static_cast<float>(action[i])) * mask_[i];
       d->ctrl[i] = action_[i];
     }
     const double before = x_before_;
+    // SlimHumanoid pays for the root x-velocity of the state the step starts from, read from the
+    // float32 observation (its index 22).
+    const double start_vx = static_cast<float>(d->qvel[0]);
     for (int k = 0; k < spec_.frame_skip; ++k) mj_step(m, d);
     if (options_.contact_forces) mj_rnePostConstraint(m, d);
     x_before_ = forward_position();
     const double velocity = (x_before_ - before) / spec_.dt;
-    double ctrl2 = 0;
-    for (double a : action_) ctrl2 += a * a;
     StepResult out;
-    out.reward = reward(velocity, ctrl2);
-    info_.x_velocity = velocity;
+    out.reward = reward(velocity, start_vx);
+    info_.x_velocity = rules_.reward == Reward::kSlim ? start_vx : velocity;
     info_.steps++;
     out.truncated = info_.steps >= spec_.horizon;
     write_observation(velocity);
@@ -172,46 +237,88 @@ class Locomotion final : public SamiEnv {
   }
 
  private:
-  // The x coordinate whose change is the forward velocity: root x, or the mass centre for
-  // SlimHumanoid.
+  // One episode's hidden parameters (at most three crippled units).
+  struct Draw {
+    double mass = 1, damping = 1;
+    std::array<int, 3> units{};
+    int crippled = 0;
+    bool mask = true;
+  };
+
+  // The x whose change over a step is the forward velocity.
   double forward_position() const {
-    if (rules_.reward != Reward::kSlim) return data_->qpos[0];
-    double mx = 0, mass = 0;
-    for (int b = 1; b < model_.nbody; ++b) {
-      mx += model_.body_mass[b] * data_->xipos[3 * b];
-      mass += model_.body_mass[b];
-    }
-    return mx / mass;
+    return rules_.forward == Forward::kTorsoXpos ? data_->xpos[3 * 1] : data_->qpos[0];
   }
 
-  double reward(double velocity, double ctrl2) const {
+  // sum(a^2) of the (masked) action as the reference computes it: in float32 on the float32
+  // action, or in float64 (crippled envs, humanoids' data.ctrl), both in NumPy's order.
+  double ctrl_squares() const {
+    const int n = spec_.action_size;
+    if (rules_.ctrl_cost_f32) {
+      std::array<float, kMaxSquares> sq;
+      for (int i = 0; i < n; ++i) {
+        const float a = static_cast<float>(action_[i]);
+        sq[i] = a * a;
+      }
+      return numpy_sum(sq.data(), n);
+    }
+    std::array<double, kMaxSquares> sq;
+    for (int i = 0; i < n; ++i) sq[i] = action_[i] * action_[i];
+    return numpy_sum(sq.data(), n);
+  }
+
+  // sum of squares of cfrc_ext, each entry clipped to [-1, 1] first when `clip`.
+  double cfrc_squares(bool clip) const {
+    const int n = 6 * model_.nbody;
+    std::array<double, kMaxSquares> sq;
+    for (int i = 0; i < n; ++i) {
+      const double f = clip ? std::clamp(data_->cfrc_ext[i], -1.0, 1.0) : data_->cfrc_ext[i];
+      sq[i] = f * f;
+    }
+    return numpy_sum(sq.data(), n);
+  }
+
+  // The reference's rewards term by term, in its order of operations (tma_sami.md §7.1). cfrc_ext
+  // stays zero unless options_.contact_forces (as in the published runs).
+  double reward(double velocity, double start_vx) const {
     const mjData* d = data_.get();
+    const double ctrl = rules_.ctrl_cost * ctrl_squares();
     switch (rules_.reward) {
       case Reward::kCheetah:
-        return velocity - rules_.ctrl_cost * ctrl2;
-      case Reward::kAnt: {
-        // cfrc_ext stays zero unless options_.contact_forces (as in the published runs).
-        double contact = 0;
-        for (int i = 0; i < 6 * model_.nbody; ++i) {
-          const double f = std::clamp(d->cfrc_ext[i], -1.0, 1.0);
-          contact += f * f;
-        }
-        return velocity - rules_.ctrl_cost * ctrl2 - 0.5 * contact + 1.0;
-      }
+        // The forward term is the float32 observation's first entry.
+        return static_cast<double>(static_cast<float>(velocity)) - ctrl;
+      case Reward::kAnt:
+        return velocity - ctrl - 0.5 * cfrc_squares(true) + 1.0;
       case Reward::kHopWalk:
-        return velocity + 1.0 - rules_.ctrl_cost * ctrl2;
+        return velocity + 1.0 - ctrl;
       case Reward::kSlim: {
+        // 0.25 / 0.015 per m/s of the start's root x-velocity; the alive bonus needs the torso
+        // between 1 and 2 m after the step; no termination.
         const double z = d->qpos[2];
-        return 0.25 * velocity - rules_.ctrl_cost * ctrl2 + (z >= 1.0 && z <= 2.0 ? 5.0 : 0.0);
+        const double alive = (z < 1.0 || z > 2.0) ? 0.0 : 5.0;
+        return (0.25 / 0.015) * start_vx - ctrl - 0.0 + alive;
       }
-      case Reward::kStandup: {
-        double impact = 0;
-        for (int i = 0; i < 6 * model_.nbody; ++i) impact += d->cfrc_ext[i] * d->cfrc_ext[i];
-        return d->qpos[2] / model_.opt.timestep - rules_.ctrl_cost * ctrl2 -
-               std::min(0.5e-6 * impact, 10.0) + 1.0;
-      }
+      case Reward::kStandup:
+        return d->qpos[2] / model_.opt.timestep - ctrl -
+               std::min(0.5e-6 * cfrc_squares(false), 10.0) + 1.0;
     }
     return 0;
+  }
+
+  // Puts the shared model's values back into the private arrays the parameters change.
+  void restore_parameters() {
+    const mjModel* m = shared_.get();
+    std::copy_n(m->body_mass, body_mass_.size(), body_mass_.begin());
+    std::copy_n(m->dof_damping, dof_damping_.size(), dof_damping_.begin());
+    std::copy_n(m->geom_size, geom_size_.size(), geom_size_.begin());
+    std::copy_n(m->geom_rgba, geom_rgba_.size(), geom_rgba_.begin());
+  }
+
+  // Writes one episode's parameters over the restored arrays and sets the action mask.
+  void apply(const Draw& draw) {
+    scale(draw.mass, draw.damping);
+    std::fill(mask_.begin(), mask_.end(), 1.0);
+    for (int i = 0; i < draw.crippled; ++i) cripple(draw.units[i], draw.mask);
   }
 
   // Mass and damping factors, per the env's rule (sami_models.md §2).
@@ -225,14 +332,18 @@ class Locomotion final : public SamiEnv {
       case Scaling::kMassOnly:
         for (int b = 0; b < m->nbody; ++b) body_mass_[b] = m->body_mass[b] * mass;
         break;
-      case Scaling::kAntSplit:
-        // Bodies and dofs 2..7 times the factor, 8..13 divided by it: for bodies that is legs
-        // 1-2 against 3-4, for dofs (which start with 6 root dofs) leg 1 against legs 2-4.
+      case Scaling::kAntSplit: {
+        // Bodies and dofs 2..7 times the factor, 8..13 times its reciprocal (the reference
+        // multiplies by 1.0 / factor, which differs from dividing by one ulp for some factors):
+        // for bodies that is legs 1-2 against 3-4, for dofs (which start with 6 root dofs)
+        // leg 1 against legs 2-4.
+        const double inv_mass = 1.0 / mass, inv_damping = 1.0 / damping;
         for (int i = 2; i < 14; ++i) {
-          body_mass_[i] = i < 8 ? m->body_mass[i] * mass : m->body_mass[i] / mass;
-          dof_damping_[i] = i < 8 ? m->dof_damping[i] * damping : m->dof_damping[i] / damping;
+          body_mass_[i] = m->body_mass[i] * (i < 8 ? mass : inv_mass);
+          dof_damping_[i] = m->dof_damping[i] * (i < 8 ? damping : inv_damping);
         }
         break;
+      }
     }
   }
 
@@ -296,6 +407,7 @@ class Locomotion final : public SamiEnv {
   Options options_;
   std::vector<double> mask_, action_;
   double x_before_ = 0;
+  Draw last_;  // the parameters in force (before the first episode: the model's own)
 };
 
 }  // namespace

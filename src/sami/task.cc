@@ -186,7 +186,10 @@ std::vector<TaskSet> split_sets(EnvId id, Split split) {
       return quadrants(lo[s], hi[s]);
     }
     case EnvId::kAnt: {
-      if (split == Split::kExtreme) return {{.mass = {0.4, 0.5, 0.6}, .damping = {1.0}}};
+      // The extreme test of SaMI's tools/rewrite_config.py: m in 0.40..0.60 by 0.05, d = 1.
+      if (split == Split::kExtreme) {
+        return {{.mass = {0.4, 0.45, 0.5, 0.55, 0.6}, .damping = {1.0}}};
+      }
       const Values lo[2] = {{0.75, 0.85}, {0.4, 0.5}};
       const Values hi[2] = {{1.0, 1.15, 1.25}, {1.5, 1.6}};
       return quadrants(lo[s], hi[s]);
@@ -207,7 +210,10 @@ std::vector<TaskSet> split_sets(EnvId id, Split split) {
     case EnvId::kCrippleHalfCheetah: {
       if (split == Split::kTrain) return mass_groups({kTrainMass}, singles({3, 4, 5}));
       if (split == Split::kModerate) return mass_groups(kModerateMass, singles({0, 1, 2}));
-      return mass_groups(kExtremeMass, pairs({3, 4, 5}, {0, 1, 2}));
+      // Two distinct joints of all six: the env's two-joint mode draws both from one set (it
+      // cannot ask for one front and one back), and SaMI's own extreme demo cripples 4 and 5.
+      const std::vector<int> all = {0, 1, 2, 3, 4, 5};
+      return mass_groups(kExtremeMass, pairs(all, all));
     }
     case EnvId::kCrippleAnt: {
       if (split == Split::kTrain) return mass_groups({kTrainMass}, singles({0, 1, 2, 3}));
