@@ -30,7 +30,7 @@ export LSAN_OPTIONS ?= suppressions=$(CURDIR)/scripts/lsan.supp:print_suppressio
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
 endif
 
-.PHONY: all deps configure build run test install install-python format clean
+.PHONY: all deps configure build run test bench install install-python format clean
 
 all: build
 
@@ -51,8 +51,14 @@ run: build
 	  --intrinsic $(INTRINSIC) --steps $(STEPS) --envs $(ENVS) --eval-episodes $(EPISODES) \
 	  --compare-random
 
+# The tests (and only they) are built here: `make build` and `make run` compile no test target.
 test: build
+	@$(NICE) cmake --build $(BUILD_DIR) -j $(JOBS) --target cradle_tests
 	@cd $(BUILD_DIR) && $(NICE) ctest --output-on-failure -j $(JOBS)
+
+# Google Benchmark targets (build/cradle_bench, build/teach_bench); `cradle bench` is the CLI's.
+bench: build
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target cradle_benches
 
 # `make install CMAKE_INSTALL_PREFIX=DIR`: the CLI into DIR/bin and its data files into
 # DIR/share/cradle (default: the prefix the build was configured with, /usr/local).
