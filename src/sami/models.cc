@@ -231,62 +231,67 @@ std::string ant() {
   return x.str();
 }
 
-// Planar root of the hopper and walker: x slide, z slide with ref 1.25, y hinge.
+// Planar root of the hopper and walker: x slide, z slide with ref 1.25, y hinge at the torso.
 void planar_root(XmlWriter& x) {
-  const Attrs free = {{"armature", "0"}, {"damping", "0"}, {"limited", "false"}, {"pos", "0 0 0"}};
+  const Attrs free = {{"armature", "0"}, {"damping", "0"}, {"limited", "false"}};
   auto joint = [&](Attrs a) {
     a.insert(a.end(), free.begin(), free.end());
     x.leaf("joint", a);
   };
-  joint({{"name", "rootx"}, {"type", "slide"}, {"axis", "1 0 0"}});
-  joint({{"name", "rootz"}, {"type", "slide"}, {"axis", "0 0 1"}, {"ref", "1.25"}});
-  joint({{"name", "rooty"}, {"type", "hinge"}, {"axis", "0 1 0"}});
+  joint({{"name", "rootx"}, {"type", "slide"}, {"axis", "1 0 0"}, {"pos", "0 0 0"}});
+  joint(
+      {{"name", "rootz"}, {"type", "slide"}, {"axis", "0 0 1"}, {"pos", "0 0 0"}, {"ref", "1.25"}});
+  joint({{"name", "rooty"}, {"type", "hinge"}, {"axis", "0 1 0"}, {"pos", "0 0 1.25"}});
 }
 
-// One planar leg (thigh, leg, foot), written in local coordinates equal to gym's global file.
-void planar_leg(XmlWriter& x, const std::string& suffix, double foot_x0, double foot_x1,
-                double foot_body_x, const char* foot_friction) {
-  x.open("body", {{"name", "thigh" + suffix}, {"pos", "0 0 -.2"}});
+// One planar leg (thigh, leg, foot) in gym's global coordinates, written with gym's numbers: the
+// compiler's global-to-local conversion then rounds exactly as it does for gym's file (a local
+// rewrite differs from it in the last 1-3 bits of positions, masses and inertias).
+void planar_leg(XmlWriter& x, const std::string& suffix, const char* foot_fromto,
+                const char* foot_body_pos, const char* foot_friction) {
+  x.open("body", {{"name", "thigh" + suffix}, {"pos", "0 0 1.05"}});
   x.leaf("joint", {{"name", "thigh" + suffix + "_joint"},
                    {"type", "hinge"},
-                   {"pos", "0 0 0"},
+                   {"pos", "0 0 1.05"},
                    {"axis", "0 -1 0"},
                    {"range", "-150 0"}});
   x.leaf("geom", {{"name", "thigh" + suffix + "_geom"},
                   {"type", "capsule"},
-                  {"fromto", "0 0 0 0 0 -.45"},
-                  {"size", ".05"},
-                  {"friction", ".9"}});
-  x.open("body", {{"name", "leg" + suffix}, {"pos", "0 0 -.7"}});
+                  {"fromto", "0 0 1.05 0 0 0.6"},
+                  {"size", "0.05"},
+                  {"friction", "0.9"}});
+  x.open("body", {{"name", "leg" + suffix}, {"pos", "0 0 0.35"}});
   x.leaf("joint", {{"name", "leg" + suffix + "_joint"},
                    {"type", "hinge"},
-                   {"pos", "0 0 .25"},
+                   {"pos", "0 0 0.6"},
                    {"axis", "0 -1 0"},
                    {"range", "-150 0"}});
   x.leaf("geom", {{"name", "leg" + suffix + "_geom"},
                   {"type", "capsule"},
-                  {"fromto", "0 0 .25 0 0 -.25"},
-                  {"size", ".04"},
-                  {"friction", ".9"}});
-  x.open("body", {{"name", "foot" + suffix}, {"pos", nums({foot_body_x, 0, -0.35})}});
+                  {"fromto", "0 0 0.6 0 0 0.1"},
+                  {"size", "0.04"},
+                  {"friction", "0.9"}});
+  x.open("body", {{"name", "foot" + suffix}, {"pos", foot_body_pos}});
   x.leaf("joint", {{"name", "foot" + suffix + "_joint"},
                    {"type", "hinge"},
-                   {"pos", nums({-foot_body_x, 0, 0.1})},
+                   {"pos", "0 0 0.1"},
                    {"axis", "0 -1 0"},
                    {"range", "-45 45"}});
   x.leaf("geom", {{"name", "foot" + suffix + "_geom"},
                   {"type", "capsule"},
-                  {"fromto", nums({foot_x0 - foot_body_x, 0, 0.1, foot_x1 - foot_body_x, 0, 0.1})},
-                  {"size", ".06"},
+                  {"fromto", foot_fromto},
+                  {"size", "0.06"},
                   {"friction", foot_friction}});
   x.close().close().close();
 }
 
-// Hopper (§1.3) and Walker2d (§1.4): gym's global-coordinate files rewritten in local form.
+// Hopper (§1.3) and Walker2d (§1.4) in gym's global coordinates (MuJoCo 2.2.2 still reads them),
+// so they compile to gym's numbers bit for bit. The hopper's foot is at (0.13, 0, 0) (SaMI's copy
+// writes an expression there that MuJoCo cannot read).
 std::string planar(bool walker) {
   XmlWriter x;
   x.open("mujoco", {{"model", walker ? "walker2d" : "hopper"}});
-  x.leaf("compiler", {{"angle", "degree"}, {"coordinate", "local"}, {"inertiafromgeom", "true"}});
+  x.leaf("compiler", {{"angle", "degree"}, {"coordinate", "global"}, {"inertiafromgeom", "true"}});
   x.open("default");
   if (walker) {
     x.leaf("joint", {{"armature", "0.01"}, {"damping", ".1"}, {"limited", "true"}});
@@ -313,7 +318,7 @@ std::string planar(bool walker) {
   x.open("worldbody");
   light(x);
   Attrs floor = {
-      {"name", "floor"},    {"type", "plane"}, {"size", walker ? "40 40 .1" : "20 20 .125"},
+      {"name", "floor"},    {"type", "plane"}, {"size", walker ? "40 40 40" : "20 20 .125"},
       {"conaffinity", "1"}, {"condim", "3"},   {"material", "grid"}};
   if (walker) floor.push_back({"friction", ".7 .1 .1"});
   x.leaf("geom", floor);
@@ -322,14 +327,14 @@ std::string planar(bool walker) {
   planar_root(x);
   x.leaf("geom", {{"name", "torso_geom"},
                   {"type", "capsule"},
-                  {"fromto", "0 0 .2 0 0 -.2"},
-                  {"size", ".05"},
-                  {"friction", ".9"}});
+                  {"fromto", "0 0 1.45 0 0 1.05"},
+                  {"size", "0.05"},
+                  {"friction", "0.9"}});
   if (walker) {
-    planar_leg(x, "", 0, 0.2, 0.2, ".9");
-    planar_leg(x, "_left", 0, 0.2, 0.2, "1.9");
+    planar_leg(x, "", "-0.0 0 0.1 0.2 0 0.1", "0.2 0 0", "0.9");
+    planar_leg(x, "_left", "-0.0 0 0.1 0.2 0 0.1", "0.2 0 0", "1.9");
   } else {
-    planar_leg(x, "", -0.13, 0.26, 0.13, "2.0");
+    planar_leg(x, "", "-0.13 0 0.1 0.26 0 0.1", "0.13 0 0", "2.0");
   }
   x.close().close();
   x.open("actuator");

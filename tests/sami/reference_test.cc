@@ -315,7 +315,8 @@ std::string hex(std::uint64_t v) {
 
 TEST(SamiReference, CompiledModelsAndTrajectoriesMatchTheirGoldenDigests) {
   // A change here changes every SaMI result on these envs: re-run the comparison with the
-  // reference (docs/fidelity.md) before updating a digest.
+  // reference (docs/fidelity.md) before updating a digest. The Hopper and Walker model digests
+  // are those of gym's own hopper.xml and walker2d.xml compiled by MuJoCo 2.2.2.
   struct Golden {
     EnvId id;
     const char* model;
@@ -326,6 +327,8 @@ TEST(SamiReference, CompiledModelsAndTrajectoriesMatchTheirGoldenDigests) {
       {EnvId::kHalfCheetah, "131e4dc4254be7d7", "e9f488df48e136cc", "57ac5244de44760a"},
       {EnvId::kAnt, "ddf202c3a6ce2373", "178c72bb99be32f5", "75099ae1614b014e"},
       {EnvId::kHumanoidStandup, "ab7d16a39d4306ab", "aa8cfd0365e609b3", "de2fc128996511ab"},
+      {EnvId::kHopper, "437c3874caf413e7", "698db6ca2471c168", "e784cee13fb56b81"},
+      {EnvId::kWalker, "143ee7738608a231", "e265b74a18ca3997", "a330102b5f9c8d71"},
   };
   for (const Golden& g : golden) {
     auto env = make_env(g.id, split_sets(g.id, Split::kTrain), 0);
