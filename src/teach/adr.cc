@@ -61,6 +61,7 @@ class AdrTeacher final : public Teacher {
   }
 
   void episodic_update(const Task& task, double ret, bool) override {
+    check_episode(task, ret);
     ++episode_;
     for (int i = 0; i < dims(); ++i) {
       // Min side: expand down to the global min, shrink up to the current max.

@@ -25,6 +25,7 @@ class AlpGmmTeacher final : public GmmTeacher {
   }
 
   void episodic_update(const Task& task, double ret, bool) override {
+    check_episode(task, ret);
     // ALP against the nearest earlier task (raw coordinates), once more than 5 are known.
     double alp = 0;
     if (history_.size() > 5) {

@@ -21,6 +21,7 @@ class CovarGmmTeacher final : public GmmTeacher {
         absolute_lp_(p.absolute_lp) {}
 
   void episodic_update(const Task& task, double ret, bool) override {
+    check_episode(task, ret);
     // [task, index within the batch / fit_rate, return].
     const int in_batch = static_cast<int>(rows_.size() % static_cast<std::size_t>(fit_rate()));
     std::vector<double> row(task.begin(), task.end());
@@ -33,7 +34,7 @@ class CovarGmmTeacher final : public GmmTeacher {
       const std::size_t start = rows_.size() - fit_rate();
       for (int r = 0; r < fit_rate(); ++r)
         for (int c = 0; c < dims() + 2; ++c) x(r, c) = rows_[start + r][c];
-      refit(x, "aic");
+      if (!refit(x, "aic")) return;  // the previous mixture and its progress stay
       lps_.assign(gmm().k(), 0.0);
       for (int j = 0; j < gmm().k(); ++j) {
         const double cov_tr = gmm().covs[j](dims(), dims() + 1);

@@ -66,6 +66,16 @@ void m_step(const Eigen::MatrixXd& x, const Eigen::MatrixXd& r, double reg, Gmm&
 
 }  // namespace
 
+bool usable(const Gmm& gmm) {
+  if (gmm.k() == 0 || !std::isfinite(gmm.aic) || !std::isfinite(gmm.bic)) return false;
+  for (int j = 0; j < gmm.k(); ++j) {
+    if (!std::isfinite(gmm.weights[j]) || !gmm.means[j].allFinite() || !gmm.covs[j].allFinite())
+      return false;
+    if (Eigen::LLT<Eigen::MatrixXd>(gmm.covs[j]).info() != Eigen::Success) return false;
+  }
+  return true;
+}
+
 double standard_normal(Rng& rng) {
   const double u1 = 1.0 - rng.uniform(), u2 = rng.uniform();
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
@@ -77,6 +87,7 @@ Gmm fit_gmm(const Eigen::MatrixXd& x, int k, Rng& rng, const GmmOptions& options
   if (n < k)
     throw UserError("gmm: " + std::to_string(n) + " points for k = " + std::to_string(k) +
                     "; expected at least k points");
+  if (!x.allFinite()) throw UserError("gmm: the points hold a non-finite value; expected finite");
   Gmm g;
   g.weights.assign(k, 1.0 / k);
   g.means.assign(k, Eigen::VectorXd::Zero(d));
@@ -118,6 +129,9 @@ Gmm fit_best_gmm(const Eigen::MatrixXd& x, const std::vector<int>& ks, const std
   for (int k : ks) {
     Gmm g = fit_gmm(x, k, rng, options);
     const double score = criterion == "aic" ? g.aic : g.bic;
+    // A fit whose covariances lost positive definiteness (points far apart in scale) is no
+    // candidate: sampling from it would give NaN tasks.
+    if (!usable(g)) continue;
     if (score < best_score) {
       best_score = score;
       best = std::move(g);

@@ -28,9 +28,13 @@ struct GmmOptions {
 
 // Fits k components to the rows of x. Throws UserError when k < 1 or x has fewer than k rows.
 Gmm fit_gmm(const Eigen::MatrixXd& x, int k, Rng& rng, const GmmOptions& options = {});
-// Fits every k of ks and keeps the lowest criterion ("aic" or "bic"; else UserError).
+// Fits every k of ks and keeps the lowest criterion ("aic" or "bic"; else UserError) among the
+// usable fits; a Gmm with no component when none is.
 Gmm fit_best_gmm(const Eigen::MatrixXd& x, const std::vector<int>& ks, const std::string& criterion,
                  Rng& rng, const GmmOptions& options = {});
+// True when the mixture has components, finite scores, weights and means, and positive-definite
+// covariances (so that sample_component gives finite draws).
+bool usable(const Gmm& gmm);
 // One draw from component j.
 Eigen::VectorXd sample_component(const Gmm& gmm, int j, Rng& rng);
 // Standard normal (Box-Muller).

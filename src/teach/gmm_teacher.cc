@@ -46,6 +46,7 @@ nlohmann::json GmmTeacher::dump() const {
   nlohmann::json j = Teacher::dump();
   j["episodes"] = origins_.size();
   j["fits"] = fits_;
+  j["failed_fits"] = failed_fits_;
   j["task_origins"] = origins_;
   return j;
 }
@@ -55,10 +56,18 @@ bool GmmTeacher::record_episode() {
   return origins_.size() % static_cast<std::size_t>(p_.fit_rate) == 0;
 }
 
-void GmmTeacher::refit(const Eigen::MatrixXd& x, const std::string& criterion) {
-  gmm_ = fit_best_gmm(x, p_.potential_ks, criterion, fit_rng_);
-  fitted_ = true;
+bool GmmTeacher::refit(const Eigen::MatrixXd& x, const std::string& criterion) {
+  Gmm g = fit_best_gmm(x, p_.potential_ks, criterion, fit_rng_);
   ++fits_;
+  // No usable mixture (degenerate data): keep sampling from the previous one, or uniformly
+  // before the first, rather than from a mixture that would give NaN tasks.
+  if (!usable(g)) {
+    ++failed_fits_;
+    return false;
+  }
+  gmm_ = std::move(g);
+  fitted_ = true;
+  return true;
 }
 
 int GmmTeacher::pick_component() {

@@ -41,8 +41,9 @@ class GmmTeacher : public Teacher {
   virtual double progress(int c) const = 0;
   // Books the episode just played; true when fit_rate episodes have passed since the last fit.
   bool record_episode();
-  // Fits the best of potential_ks components to the rows of x by `criterion` (aic or bic).
-  void refit(const Eigen::MatrixXd& x, const std::string& criterion);
+  // Fits the best of potential_ks components to the rows of x by `criterion` (aic or bic); false
+  // (the previous mixture kept, failed_fits counted) when no fit is usable.
+  bool refit(const Eigen::MatrixXd& x, const std::string& criterion);
 
   int fit_rate() const { return p_.fit_rate; }
   const Gmm& gmm() const { return gmm_; }
@@ -57,7 +58,7 @@ class GmmTeacher : public Teacher {
   Rng fit_rng_;
   Gmm gmm_;
   bool fitted_ = false;
-  int fits_ = 0;
+  int fits_ = 0, failed_fits_ = 0;
   std::vector<int> origins_;
   int last_origin_ = -1;
 };

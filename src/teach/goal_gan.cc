@@ -90,7 +90,8 @@ class GoalGanTeacher final : public Teacher {
     return goal;
   }
 
-  void episodic_update(const Task& task, double, bool success) override {
+  void episodic_update(const Task& task, double ret, bool success) override {
+    check_episode(task, ret);
     // Only generated goals are labelled, once all their rollouts are in.
     auto it = pending_.find(task);
     if (it == pending_.end()) return;

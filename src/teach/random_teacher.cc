@@ -8,7 +8,7 @@ class RandomTeacher final : public Teacher {
  public:
   using Teacher::Teacher;
   Task sample_task() override { return uniform_task(); }
-  void episodic_update(const Task&, double, bool) override {}
+  void episodic_update(const Task& task, double ret, bool) override { check_episode(task, ret); }
   const char* name() const override { return "random"; }
 };
 

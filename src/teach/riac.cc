@@ -73,6 +73,7 @@ class RiacTeacher final : public Teacher {
   }
 
   void episodic_update(const Task& task, double ret, bool) override {
+    check_episode(task, ret);
     // Walk down the matching path, adding the pair to every node on it.
     int node = 0;
     while (node >= 0) {

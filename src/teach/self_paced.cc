@@ -97,13 +97,15 @@ class SelfPacedTeacher final : public Teacher {
   void set_value_estimator(ValueEstimator estimator) override { value_ = std::move(estimator); }
 
   void record_initial_state(const Task& task, const std::vector<float>& s0) override {
+    check_initial_state(task, s0);
     // At most 1000 (state, task) pairs; the oldest go first.
     if (contexts_.size() == 1000) contexts_.pop_front();
     contexts_.push_back({s0, task});
   }
 
-  void step_update(const std::vector<float>&, const std::vector<float>&, double r,
-                   const std::vector<float>&, bool done) override {
+  void step_update(const std::vector<float>& s, const std::vector<float>& a, double r,
+                   const std::vector<float>& s_next, bool done) override {
+    check_step(s, a, r, s_next);
     // The discounted return of the running episode.
     ++steps_;
     episode_return_ += discount_ * r;
@@ -118,7 +120,7 @@ class SelfPacedTeacher final : public Teacher {
       update();
   }
 
-  void episodic_update(const Task&, double, bool) override {}
+  void episodic_update(const Task& task, double ret, bool) override { check_episode(task, ret); }
 
   nlohmann::json dump() const override {
     nlohmann::json j = Teacher::dump();
@@ -146,7 +148,6 @@ class SelfPacedTeacher final : public Teacher {
       throw UserError(
           "self_paced: no value estimator; the student must call set_value_estimator before the "
           "first update");
-    ++iteration_;
     // Values of the buffered initial states; tasks as columns.
     std::vector<std::vector<float>> states;
     Eigen::MatrixXd c(dims(), static_cast<int>(contexts_.size()));
@@ -154,12 +155,21 @@ class SelfPacedTeacher final : public Teacher {
       states.push_back(contexts_[i].first);
       for (int k = 0; k < dims(); ++k) c(k, static_cast<int>(i)) = contexts_[i].second[k];
     }
-    contexts_.clear();
+    // The buffer and the iteration count change only once the estimator's values are checked,
+    // so an estimator that throws or misbehaves leaves the teacher as it was.
     const std::vector<float> values = value_(states);
     if (values.size() != states.size())
       throw UserError("self_paced: the value estimator returned " + std::to_string(values.size()) +
                       " values for " + std::to_string(states.size()) +
                       " states; expected one each");
+    // A NaN value would turn the objective into NaN and silently freeze the curriculum.
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        throw UserError("self_paced: the value estimator's value " + std::to_string(i) + " is " +
+                        (std::isnan(values[i]) ? std::string("nan") : std::to_string(values[i])) +
+                        "; expected finite values");
+    contexts_.clear();
+    ++iteration_;
     const Eigen::VectorXd v =
         Eigen::Map<const Eigen::VectorXf>(values.data(), values.size()).cast<double>();
     // Alpha: zero for the first alpha_offset iterations, then a zeta share of the performance

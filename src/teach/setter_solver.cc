@@ -117,7 +117,8 @@ class SetterSolverTeacher final : public Teacher {
     return task;
   }
 
-  void episodic_update(const Task& task, double, bool success) override {
+  void episodic_update(const Task& task, double ret, bool success) override {
+    check_episode(task, ret);
     // The pending goal of this task joins the buffer; every update_frequency episodes, train.
     auto it = pending_.find(task);
     if (it != pending_.end()) {

@@ -3,12 +3,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "core/error.h"
 #include "teach/gmm.h"
 
 namespace cradle::teach {
+namespace {
+
+// A value as users write it (1e+170, nan, -inf), not std::to_string's 171 digits.
+std::string text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+// Throws UserError naming `what` unless every value is finite and within kMaxAbsReturn.
+template <typename T>
+void check_values(const std::vector<T>& values, const std::string& what) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!(std::abs(static_cast<double>(values[i])) <= kMaxAbsReturn))
+      throw UserError("teacher: " + what + " value " + std::to_string(i) + " is " +
+                      text(values[i]) +
+                      "; expected finite values of magnitude <= " + text(kMaxAbsReturn));
+}
+
+}  // namespace
 
 Teacher::Teacher(std::vector<float> mins, std::vector<float> maxs, std::uint64_t seed)
     : mins_(std::move(mins)), maxs_(std::move(maxs)), rng_(seed) {
@@ -69,6 +90,45 @@ void Teacher::check_dist(const DiagGaussian& dist, const std::string& what) cons
     if (!std::isfinite(dist.mean[i]) || !std::isfinite(dist.variance[i]) || dist.variance[i] < 0)
       throw UserError(what + ": dimension " + std::to_string(i) +
                       " has a non-finite mean or a negative variance; expected finite, >= 0");
+}
+
+void Teacher::check_episode(const Task& task, double ret) const {
+  // A GMM or a network fitted on a NaN, or on a task read past its end, is garbage from then on:
+  // refuse the episode before any book-keeping changes.
+  if (task.size() != mins_.size())
+    throw UserError("teacher: episode task has " + std::to_string(task.size()) +
+                    " values; expected " + std::to_string(mins_.size()) + " (the task dimensions)");
+  check_values(task, "episode task");
+  if (!(std::abs(ret) <= kMaxAbsReturn))
+    throw UserError("teacher: episode return is " + text(ret) +
+                    "; expected a finite return of magnitude <= " + text(kMaxAbsReturn));
+}
+
+void Teacher::check_initial_state(const Task& task, const std::vector<float>& s0) const {
+  if (task.size() != mins_.size())
+    throw UserError("teacher: initial-state task has " + std::to_string(task.size()) +
+                    " values; expected " + std::to_string(mins_.size()) + " (the task dimensions)");
+  check_values(task, "initial-state task");
+  check_values(s0, "initial state");
+}
+
+void Teacher::check_step(const std::vector<float>& s, const std::vector<float>& a, double r,
+                         const std::vector<float>& s_next) const {
+  if (!(std::abs(r) <= kMaxAbsReturn))
+    throw UserError("teacher: step reward is " + text(r) +
+                    "; expected a finite reward of magnitude <= " + text(kMaxAbsReturn));
+  check_values(s, "step state");
+  check_values(a, "step action");
+  check_values(s_next, "step next state");
+}
+
+void Teacher::record_initial_state(const Task& task, const std::vector<float>& s0) {
+  check_initial_state(task, s0);
+}
+
+void Teacher::step_update(const std::vector<float>& s, const std::vector<float>& a, double r,
+                          const std::vector<float>& s_next, bool /*done*/) {
+  check_step(s, a, r, s_next);
 }
 
 nlohmann::json Teacher::dump() const {

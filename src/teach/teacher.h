@@ -16,6 +16,11 @@ namespace cradle::teach {
 
 using Task = std::vector<float>;
 
+// The largest return (and task coordinate) in magnitude a teacher accepts. No env comes near it
+// (TeachMyAgent's returns are in the hundreds), and it keeps the GMM teachers' squared deviations
+// (at most ~1e31 per value) far from overflow.
+inline constexpr double kMaxAbsReturn = 1e15;
+
 // A diagonal Gaussian in the teacher's task space (an env's easy region, SPDL's target).
 struct DiagGaussian {
   std::vector<float> mean, variance;
@@ -37,13 +42,16 @@ class Teacher {
   // A task with no exploration noise (curriculum snapshots); by default a normal sample.
   virtual Task non_exploratory_task_sampling() { return sample_task(); }
   virtual bool is_non_exploratory_task_sampling_available() const { return true; }
-  // Only step-driven teachers (SPDL) use these two.
-  virtual void record_initial_state(const Task& /*task*/, const std::vector<float>& /*s0*/) {}
-  virtual void step_update(const std::vector<float>& /*s*/, const std::vector<float>& /*a*/,
-                           double /*r*/, const std::vector<float>& /*s_next*/, bool /*done*/) {}
+  // Only step-driven teachers (SPDL) use these two; every teacher checks their values (a
+  // UserError on a task of another size, non-finite values or a reward beyond kMaxAbsReturn).
+  virtual void record_initial_state(const Task& task, const std::vector<float>& s0);
+  virtual void step_update(const std::vector<float>& s, const std::vector<float>& a, double r,
+                           const std::vector<float>& s_next, bool done);
   // The student hands its value function over once; only SPDL uses it.
   virtual void set_value_estimator(ValueEstimator /*estimator*/) {}
-  // End of a training episode played on `task`.
+  // End of a training episode played on `task`. Throws UserError (before changing anything) when
+  // the task has another size than dims() or a coordinate that is not finite or beyond
+  // kMaxAbsReturn, or when the return is.
   virtual void episodic_update(const Task& task, double ret, bool success) = 0;
   // Book-keeping as JSON (name, bounds, and the teacher's own records).
   virtual nlohmann::json dump() const;
@@ -62,6 +70,11 @@ class Teacher {
   Task gaussian_task(const DiagGaussian& dist);
   // subspace: mean uniform in the box, std 10 % of each range; else the box centre, std range / 4.
   DiagGaussian dist_from_bounds(bool subspace);
+  // The checks of episodic_update, record_initial_state and step_update, for their overrides.
+  void check_episode(const Task& task, double ret) const;
+  void check_initial_state(const Task& task, const std::vector<float>& s0) const;
+  void check_step(const std::vector<float>& s, const std::vector<float>& a, double r,
+                  const std::vector<float>& s_next) const;
   // Throws UserError (naming `what`) unless dist has dims() finite means and variances >= 0.
   void check_dist(const DiagGaussian& dist, const std::string& what) const;
 
