@@ -144,14 +144,30 @@ def test_editable_install_imports_the_build_tree(tmp_path):
     assert f"data files: {SOURCE} (source tree)" in version, version
 
 
-def test_cmake_install_uses_the_data_of_its_prefix(tmp_path):
-    # `make install CMAKE_INSTALL_PREFIX=...` without the rebuild `make install` starts with.
+@pytest.fixture(scope="module")
+def prefix(tmp_path_factory):
+    """`make install CMAKE_INSTALL_PREFIX=...` without the rebuild `make install` starts with."""
     build = os.environ.get("CRADLE_BUILD_DIR") or os.path.join(SOURCE, "build")
-    prefix = tmp_path / "prefix"
-    subprocess.run(["cmake", "--install", build, "--prefix", str(prefix)], check=True,
+    folder = tmp_path_factory.mktemp("prefix")
+    subprocess.run(["cmake", "--install", build, "--prefix", str(folder)], check=True,
                    capture_output=True)
+    return folder
+
+
+def test_cmake_install_uses_the_data_of_its_prefix(prefix, tmp_path):
     cradle = str(prefix / "bin" / "cradle")
     version = run([cradle, "--version"], str(prefix)).stdout
     assert f"data files: {prefix / 'share' / 'cradle'}" in version, version
     run([cradle, "tma", "random", "--env", "parkour", "--steps", "20"], str(prefix),
         cwd=str(tmp_path))
+
+
+def test_find_package_builds_a_program_on_the_installed_library(prefix, tmp_path):
+    build = tmp_path / "build"
+    run(["cmake", "-S", os.path.join(SOURCE, "tests", "install", "consumer"), "-B", str(build),
+         f"-DCMAKE_PREFIX_PATH={prefix}"], str(prefix))
+    run(["cmake", "--build", str(build)], str(prefix))
+    # A program of the user's own is not installed with the data: it is told where they are.
+    out = run([str(build / "consumer")], str(prefix),
+              CRADLE_TMA_DATA=str(prefix / "share" / "cradle" / "data" / "teachmyagent")).stdout
+    assert "5 Parkour steps" in out, out
