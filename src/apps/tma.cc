@@ -7,7 +7,8 @@
 //          --nb_pairs_of_legs, --under_water, --outside_water, --CPPN_weights_path,
 //          --input_CPPN_dim, --ceiling_offset, --ceiling_clip_offset);
 //   bench  --env ... --embodiment E|all [--steps N] [--json]: env steps/s and the ratio to the
-//          bare b2World::Step on the same world, measured in one run, plus the reset time;
+//          bare b2World::Step replaying the env's motor commands (apps/tma_bench.h), plus the
+//          reset time;
 //   info   : observation / action sizes and masses of every embodiment in both envs (JSON).
 #include <chrono>
 #include <cmath>
@@ -22,6 +23,7 @@
 
 #include "apps/commands.h"
 #include "apps/interrupt.h"
+#include "apps/tma_bench.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/rng.h"
@@ -59,59 +61,6 @@ tma::TaskParam parse_task(const std::string& text) {
     start = comma + 1;
   }
   return p;
-}
-
-struct BenchResult {
-  double env_steps_per_s = 0, bare_steps_per_s = 0, ratio = 0, reset_ms = 0, mass = 0;
-};
-
-// Env steps with random actions (resets not timed), then bare world steps on the same world.
-BenchResult bench_one(tma::EnvId id, const std::string& body, int steps, std::uint64_t seed) {
-  using Clock = std::chrono::steady_clock;
-  tma::TmaEnv env(tma::TmaOptions{.env = id, .body = body});
-  if (id == tma::EnvId::kStumpTracks) {
-    env.set_environment({{"stump_height", {1.0}}, {"obstacle_spacing", {3.0}}});
-  } else {
-    env.set_environment({{"input_vector", {-0.15, 0.8, 0.1}},
-                         {"water_level", {body == "fish" ? 1.0 : 0.1}},
-                         {"creepers_width", {0.25}},
-                         {"creepers_height", {2.0}},
-                         {"creepers_spacing", {2.5}}});
-  }
-  BenchResult r;
-  const int resets = 20;
-  const Clock::time_point t0 = Clock::now();
-  for (int i = 0; i < resets; ++i) env.reset(seed + i);
-  r.reset_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count() / resets;
-  r.mass = env.agent().mass();
-
-  env.reset(seed);
-  Rng rng(seed + 1);
-  std::vector<double> action(env.action_size());
-  double env_s = 0;
-  for (int i = 0; i < steps; ++i) {
-    for (double& a : action) a = rng.uniform(-1, 1);
-    const Clock::time_point t = Clock::now();
-    const tma::TmaStep s = env.step(action);
-    env_s += std::chrono::duration<double>(Clock::now() - t).count();
-    if (s.terminated || s.truncated) env.reset();
-  }
-  // Bare: the same world, motors driven at random, only b2World::Step timed.
-  env.reset(seed);
-  double bare_s = 0;
-  for (int i = 0; i < steps; ++i) {
-    for (double& a : action) a = rng.uniform(-1, 1);
-    env.agent().activate_motors(action);
-    const Clock::time_point t = Clock::now();
-    env.world().Step(static_cast<float>(1.0 / tma::kFps), tma::kVelocityIterations,
-                     tma::kPositionIterations);
-    bare_s += std::chrono::duration<double>(Clock::now() - t).count();
-    if (i % 500 == 499) env.reset();  // keep the bare world near the same states as the env's
-  }
-  r.env_steps_per_s = steps / env_s;
-  r.bare_steps_per_s = steps / bare_s;
-  r.ratio = env_s / bare_s;
-  return r;
 }
 
 // "k=v" -> (k, v) or a one-line error naming the flag.
@@ -327,7 +276,10 @@ void register_tma(CLI::App& app) {
     bool json = false;
   };
   auto bo = std::make_shared<BenchOptions>();
-  CLI::App* bench = tma_cmd->add_subcommand("bench", "Env steps/s vs bare b2World::Step");
+  CLI::App* bench = tma_cmd->add_subcommand(
+      "bench",
+      "Env steps/s vs bare b2World::Step replaying the env's motor commands from the same state, "
+      "in alternating blocks (CPU time; ratio: the blocks' median and range)");
   bench->add_option("--env", bo->env, "stump-tracks | parkour");
   bench->add_option("--embodiment", bo->body, "Embodiment, or all");
   bench->add_option("--steps", bo->steps, "Steps timed")->check(CLI::Range(100, 100000000));
@@ -343,7 +295,8 @@ void register_tma(CLI::App& app) {
     }
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     for (const std::string& body : bodies) {
-      const BenchResult r = bench_one(id, body, bo->steps, bo->seed);
+      const TmaBenchResult r = tma_bench(id, body, bo->steps, bo->seed);
+      const Spread& ratio = r.timing.ratio;
       if (bo->json) {
         out.push_back({{"env", tma::env_id_name(id)},
                        {"embodiment", body},
@@ -351,10 +304,22 @@ void register_tma(CLI::App& app) {
                        {"env_steps_per_s", r.env_steps_per_s},
                        {"bare_steps_per_s", r.bare_steps_per_s},
                        {"ratio", r.ratio},
+                       {"ratio_min", ratio.min},
+                       {"ratio_q1", ratio.q1},
+                       {"ratio_q3", ratio.q3},
+                       {"ratio_max", ratio.max},
+                       {"blocks", ratio.count},
+                       {"block_steps", r.timing.block_steps},
+                       {"env_us_per_step", r.env_us},
+                       {"bare_us_per_step", r.bare_us},
+                       {"replay_exact", r.timing.replay_exact},
                        {"reset_ms", r.reset_ms}});
       } else {
-        std::printf("%-34s env %8.0f steps/s  bare %8.0f Step/s  ratio %.2f  reset %.2f ms\n",
-                    body.c_str(), r.env_steps_per_s, r.bare_steps_per_s, r.ratio, r.reset_ms);
+        std::printf(
+            "%-34s env %8.0f steps/s  bare %8.0f Step/s  ratio %.2f (%.2f-%.2f)  reset %.2f ms  "
+            "replay %s\n",
+            body.c_str(), r.env_steps_per_s, r.bare_steps_per_s, r.ratio, ratio.min, ratio.max,
+            r.reset_ms, r.timing.replay_exact ? "exact" : "inexact");
       }
     }
     if (bo->json) std::printf("%s\n", out.dump(2).c_str());
