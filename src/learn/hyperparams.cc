@@ -50,6 +50,8 @@ bool parse_value(std::string_view text, std::string* field) {
   return true;
 }
 bool parse_value(std::string_view text, std::vector<int>* field) {
+  // "" is the empty list; otherwise every comma separates two numbers ("64," and ",64" do not
+  // parse: a list cut short is a typo, not a shorter network).
   std::vector<int> values;
   text = trim(text);
   while (!text.empty()) {
@@ -59,6 +61,7 @@ bool parse_value(std::string_view text, std::vector<int>* field) {
     values.push_back(value);
     if (comma == std::string_view::npos) break;
     text = text.substr(comma + 1);
+    if (trim(text).empty()) return false;
   }
   *field = std::move(values);
   return true;

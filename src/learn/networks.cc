@@ -1,9 +1,11 @@
 #include "learn/networks.h"
 
 #include <dlfcn.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <thread>
@@ -24,6 +26,16 @@ void PolicyConfig::bind(Hyperparameters& table) {
 }
 
 namespace {
+
+// "64,64" (the --hp form).
+std::string layer_text(const std::vector<int>& layers) {
+  std::string text;
+  for (const int size : layers) {
+    if (!text.empty()) text += ',';
+    text += std::to_string(size);
+  }
+  return text;
+}
 
 // A `void f(int)` thread-count setter of a library LibTorch loaded, or null.
 using SetThreads = void (*)(int);
@@ -146,11 +158,37 @@ PackedParameters::PackedParameters(torch::nn::Module& module) {
   packed_.mutable_grad() = grad_;
 }
 
+double network_memory_limit() {
+  const double pages = static_cast<double>(sysconf(_SC_PHYS_PAGES));
+  const double page_size = static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  return 0.5 * pages * page_size;
+}
+
+void check_network_memory(const std::string& what, double parameters) {
+  const double bytes = 16.0 * parameters, limit = network_memory_limit();
+  if (bytes <= limit) return;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "%s: %.3g weights need %.1f GB with their gradients and Adam moments, more than "
+                "the %.1f GB allowed (half the machine's memory); lower the layer sizes",
+                what.c_str(), parameters, bytes / 1e9, limit / 1e9);
+  throw UserError(text);
+}
+
 torch::nn::Sequential make_mlp(int input, const std::vector<int>& layers,
                                const std::string& activation) {
   if (activation != "tanh" && activation != "relu") {
     throw UserError("activation '" + activation + "': expected tanh or relu");
   }
+  // Every size first: the weights are allocated only for a network that fits.
+  double parameters = 0;
+  int fan_in = input;
+  for (const int size : layers) {
+    if (size <= 0) throw UserError("hidden layer sizes must be positive");
+    parameters += (static_cast<double>(fan_in) + 1) * size;
+    fan_in = size;
+  }
+  check_network_memory("network of hidden layers " + layer_text(layers), parameters);
   torch::nn::Sequential mlp;
   for (const int size : layers) {
     if (size <= 0) throw UserError("hidden layer sizes must be positive");

@@ -89,6 +89,13 @@ class PackedParameters {
   torch::Tensor packed_, grad_;
 };
 
+// Throws UserError when a network of `parameters` weights, with its gradients and two Adam
+// moments (16 bytes a weight), would need more than half the machine's memory (the replay
+// buffer's rule): an absurd layer size is a one-line error, not std::bad_alloc.
+void check_network_memory(const std::string& what, double parameters);
+// Memory limit of check_network_memory, in bytes: half the physical memory.
+double network_memory_limit();
+
 // Hidden layers Linear -> activation for each size; output size layers.back() (or `input` when
 // there are none).
 torch::nn::Sequential make_mlp(int input, const std::vector<int>& layers,

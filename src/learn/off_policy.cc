@@ -1,5 +1,6 @@
 #include "learn/off_policy.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -49,6 +50,14 @@ void OffPolicyConfig::check(std::string_view algorithm) const {
   if (!(learning_rate > 0)) throw UserError(name + ": learning_rate must be positive");
 }
 
+void OffPolicyNetworkConfig::check(std::string_view algorithm) const {
+  // The actor's output heads and the critics' last layer sit on the last hidden layer.
+  if (pi_layers.empty() || qf_layers.empty())
+    throw UserError(std::string(algorithm) + ": pi_layers and qf_layers need at least one hidden " +
+                    "layer (e.g. 256,256); got " + (pi_layers.empty() ? "pi_layers" : "qf_layers") +
+                    " empty");
+}
+
 void OffPolicyNetworkConfig::bind(Hyperparameters& table) {
   table.add("pi_layers", &pi_layers, "actor MLP hidden sizes, e.g. 256,256 (SB3 net_arch pi)");
   table.add("qf_layers", &qf_layers, "critic MLP hidden sizes, e.g. 256,256 (SB3 net_arch qf)");
@@ -74,6 +83,10 @@ CriticImpl::CriticImpl(const ObsShape& shape, int action_size, int critics,
     sizes.push_back(size);
   }
   sizes.push_back(1);
+  double parameters = 0;
+  for (size_t l = 0; l + 1 < sizes.size(); ++l)
+    parameters += critics * (static_cast<double>(sizes[l]) + 1) * sizes[l + 1];
+  check_network_memory(std::to_string(critics) + " critics (qf_layers)", parameters);
   for (size_t l = 0; l + 1 < sizes.size(); ++l) {
     const std::string name = std::to_string(l);
     weights_.push_back(

@@ -75,6 +75,7 @@ struct OffPolicyNetworkConfig {
   std::string activation = "relu";       // "relu" or "tanh" (SB3 activation_fn, nn.ReLU)
   int cnn_features = 256;                // NatureCNN output size per image (SB3 features_dim)
   void bind(Hyperparameters& table);
+  void check(std::string_view algorithm) const;  // UserError for an empty layer list
 };
 
 // n Q(s, a) networks on one encoder of their own (SB3 ContinuousCritic with
@@ -141,6 +142,7 @@ OffPolicySettings<Own> parse_off_policy_settings(std::string_view algorithm,
   settings.observation.bind(table);
   table.apply(options.hyperparameters);
   settings.loop.check(algorithm);
+  settings.networks.check(algorithm);
   settings.text = table.to_text();
   return settings;
 }

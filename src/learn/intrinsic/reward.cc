@@ -101,7 +101,9 @@ std::string Composite::describe() const {
   for (const auto& t : terms_) {
     char weight[32];
     const auto end = std::to_chars(weight, weight + sizeof(weight), t->scale()).ptr;
-    out += (out.empty() ? "" : ",") + std::string(t->name()) + ":" + std::string(weight, end);
+    // Appended piece by piece: GCC 12 at -O3 takes `"" + string` for an oversized copy.
+    if (!out.empty()) out += ',';
+    out += std::string(t->name()) + ":" + std::string(weight, end);
   }
   return out;
 }

@@ -37,7 +37,10 @@ void SamiConfig::check() const {
   need(encoder_tau > 0 && encoder_tau <= 1, "encoder_tau: expected 0 < encoder_tau <= 1");
   need(contrast_batch_size >= 2 && contrast_batch_size <= 100000,
        "contrast_batch_size: expected 2 <= contrast_batch_size <= 100000");
+  need(batch_size >= 1 && batch_size <= 100000, "batch_size: expected 1 <= batch_size <= 100000");
   need(net_arch.size() >= 1, "net_arch: expected at least one layer");
+  for (const int size : net_arch)
+    need(size >= 1 && size <= 65536, "net_arch: expected every layer size in 1..65536");
   need(lstm_hidden >= 1 && lstm_hidden <= 65536, "lstm_hidden: expected 1 <= lstm_hidden <= 65536");
   need(context_size >= 1 && context_size <= 4096,
        "context_size: expected 1 <= context_size <= 4096");
@@ -84,8 +87,15 @@ OffPolicyNetworkConfig critic_config(const SamiConfig& config) {
   return networks;
 }
 
-const SamiConfig& checked(const SamiConfig& config) {
+// The values, then the memory of the context encoders (an LSTM of 4 gates over [input, hidden],
+// online and target, with gradients and Adam moments): lstm_hidden=65536 is a one-line error,
+// not bad_alloc. The actor and critics check theirs as they are built (make_mlp, Critic).
+const SamiConfig& checked(const SamiConfig& config, int obs_size, int action_size) {
   config.check();
+  const double h = config.lstm_hidden;
+  const double lstm = 4.0 * h * (obs_size + action_size + h) + (h + 1) * config.context_size;
+  check_network_memory(
+      "sami: context encoders of lstm_hidden " + std::to_string(config.lstm_hidden), 2 * lstm);
   return config;
 }
 
@@ -101,7 +111,7 @@ ContextSac::ContextSac(std::string method, int obs_size, int action_size, const 
                        std::uint64_t seed)
     : method_(std::move(method)),
       contrast_(method_contrast(method_)),
-      config_(checked(config)),
+      config_(checked(config, obs_size, action_size)),
       obs_size_(obs_size),
       action_size_(action_size),
       generator_(at::make_generator<at::CPUGeneratorImpl>(seed)),

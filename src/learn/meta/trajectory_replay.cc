@@ -1,9 +1,11 @@
 #include "learn/meta/trajectory_replay.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include "core/error.h"
+#include "learn/replay_buffer.h"
 
 namespace cradle::learn::meta {
 
@@ -16,6 +18,21 @@ TrajectoryReplay::TrajectoryReplay(int envs, int capacity, int max_len, int obs_
       action_size_(action_size) {
   if (envs < 1 || capacity < 1 || max_len < 1 || obs_size < 1 || action_size < 1) {
     throw UserError("sami replay: envs, buffer_size, horizon and sizes must be positive");
+  }
+  // The BabyBench replay rule: the buffer may take at most half the machine's memory, checked
+  // before anything is allocated (buffer_size=1000000000 is a one-line error, not bad_alloc).
+  const double step_bytes = 4.0 * (obs_size + action_size + 1);
+  const double bytes = static_cast<double>(envs) * capacity *
+                       ((max_len + 1.0) * step_bytes + sizeof(int) + 1 + sizeof(double));
+  const double limit = replay_memory_limit();
+  if (bytes > limit) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "sami: buffer_size = %d trajectories x %d envs x %d steps need %.1f GB for the "
+                  "replay, more than the %.1f GB allowed (half the machine's memory); lower "
+                  "buffer_size (--hp buffer_size=N)",
+                  capacity, envs, max_len + 1, bytes / 1e9, limit / 1e9);
+    throw UserError(text);
   }
   const long slots = static_cast<long>(envs) * capacity;
   const long steps = slots * (max_len + 1);
