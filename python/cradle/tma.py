@@ -8,9 +8,13 @@
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     frame = env.render()                                              # (400, 600, 3) uint8
 
-``info["success"]`` is "episode return so far > 230". ``tma.gym.make(...)`` returns the same env
-with the reference's old Gym API (``reset() -> obs``, ``step() -> obs, reward, done, info``), so
-the TeachMyAgent README example runs with ``from cradle.tma import gym``.
+Observations are float32, as the reference's observation space. ``make`` also takes the
+reference's body options (``motors_torque``, ``nb_of_bodies``, ``nb_pairs_of_legs``,
+``nb_steps_under_water``, ``nb_steps_outside_water``) and Parkour options (``CPPN_weights_path``,
+``input_CPPN_dim``, ``ceiling_offset``, ``ceiling_clip_offset``); docs/tma_run.md says what each
+does. ``info["success"]`` is "episode return so far > 230". ``tma.gym.make(...)`` returns the
+same env with the reference's old Gym API (``reset() -> obs``, ``step() -> obs, reward, done,
+info``), so the TeachMyAgent README example runs with ``from cradle.tma import gym``.
 """
 
 import numbers

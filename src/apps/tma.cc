@@ -15,6 +15,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -131,6 +132,15 @@ struct EnvFlags {
     return out;
   }
 };
+
+// Whether the run folder's run.json records body or Parkour options.
+bool run_has_env_options(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "run.json");
+  if (!in) return false;
+  const nlohmann::json run = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return run.is_object() && run.contains("arguments") && run["arguments"].is_object() &&
+         run["arguments"].contains("env_options");
+}
 
 struct RunOptions {
   std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
@@ -411,8 +421,10 @@ void register_tma(CLI::App& app) {
                    {"hp", ro.hp},
                    {"out", o.out.string()},
                    {"resume", ro.resume}};
-    // Only when given, so that runs without them resume as before.
-    if (const nlohmann::json env_options = ro.env_flags.arguments(); !env_options.empty()) {
+    // Recorded when given, or when resuming a run that has them (so that leaving them out is
+    // refused by name); runs without them resume as before.
+    const nlohmann::json env_options = ro.env_flags.arguments();
+    if (!env_options.empty() || (ro.resume && run_has_env_options(o.out))) {
       o.arguments["env_options"] = env_options;
     }
     o.commit = source_commit();
