@@ -82,3 +82,106 @@ def test_errors_are_one_line_value_errors():
         cradle.teach.make_teacher("ADR", [0], [1], expert_knowledge="maximal")
     with pytest.raises(ValueError, match="mins but"):
         cradle.teach.make_teacher("Random", [0, 0], [1])
+
+
+# Small settings so that every teacher fits or trains within a few dozen episodes.
+SMALL = {
+    "ALP-GMM": dict(fit_rate=10, potential_ks=[2, 3]),
+    "Covar-GMM": dict(fit_rate=10, potential_ks=[2, 3]),
+    "RIAC": dict(max_region_size=10),
+    "GoalGAN": dict(update_size=8, n_rollouts=1, train_iterations=2),
+    "Setter-Solver": dict(update_frequency=8, setter_hidden_size=8),
+    "Self-Paced": dict(update_frequency=10, update_offset=0),
+}
+
+
+def small_teacher(name):
+    return cradle.teach.make_teacher(name, [0, 0], [3, 6], seed=1, expert_knowledge="low",
+                                     **SMALL.get(name, {}))
+
+
+def play(teacher, episodes):
+    teacher.set_value_estimator(lambda states: np.ones(len(states), dtype=np.float32))
+    for e in range(episodes):
+        task = teacher.sample_task()
+        assert np.all(np.isfinite(task)) and 0 <= task[0] <= 3 and 0 <= task[1] <= 6
+        teacher.record_initial_state(task, task)
+        teacher.step_update(task, [0.0], 1.0, task, True)
+        teacher.episodic_update(task, 200.0 if task[0] < 1 else 10.0 * (e % 3), task[0] < 1)
+
+
+@pytest.mark.parametrize("name", cradle.teach.teacher_names())
+def test_every_teacher_refuses_bad_episodes_and_keeps_working(name):
+    teacher = small_teacher(name)
+    for _ in range(3):
+        for ret in [np.nan, np.inf, -np.inf, 1e170, -1e300, 2e15]:
+            with pytest.raises(ValueError, match=r"^teacher: episode return is .*; expected a finite"):
+                teacher.episodic_update([1.0, 2.0], ret, True)
+        for task in [[], [1.0], [1.0, 2.0, 3.0], [np.nan, 2.0], np.array([1.0, np.inf]),
+                     [-np.inf, 0.0], [1.0, 1e300]]:
+            with pytest.raises(ValueError, match=r"^teacher: episode task"):
+                teacher.episodic_update(task, 1.0, False)
+        play(teacher, 20)
+    with pytest.raises(ValueError, match="initial-state task has 1 values"):
+        teacher.record_initial_state([1.0], [0.0])
+    with pytest.raises(ValueError, match="step reward is nan"):
+        teacher.step_update([0.0], [0.0], np.nan, [0.0], False)
+    assert np.all(np.isfinite(teacher.non_exploratory_task_sampling()))
+    assert isinstance(teacher.dump(), dict)
+
+
+def test_alp_gmm_fuzz_case_is_a_value_error_not_a_crash():
+    # The fuzzer's crash: non-finite and huge returns and a NaN task, then sampling and dump().
+    teacher = cradle.teach.make_teacher("ALP-GMM", [0, 0], [3, 6], seed=1, expert_knowledge="low",
+                                        fit_rate=10)
+    for n in range(40):
+        task = teacher.sample_task()
+        for bad in [np.nan, np.inf, 1e170]:
+            with pytest.raises(ValueError):
+                teacher.episodic_update(task, bad, False)
+        with pytest.raises(ValueError):
+            teacher.episodic_update([np.nan, task[1]], 1.0, False)
+        teacher.episodic_update(task, float(n % 7), False)
+    dump = teacher.dump()
+    assert dump["episodes"] == 40 and dump["fits"] == 4 and dump["failed_fits"] == 0
+    assert all(np.all(np.isfinite(c["mean"])) for c in dump["components"])
+
+
+def test_gmm_teachers_stay_finite_at_the_return_bound():
+    for name in ["ALP-GMM", "Covar-GMM"]:
+        teacher = small_teacher(name)
+        for n in range(100):
+            task = teacher.sample_task()
+            assert np.all(np.isfinite(task)) and 0 <= task[0] <= 3 and 0 <= task[1] <= 6
+            teacher.episodic_update(task, (-1) ** n * 1e15 * task[0] / 3, False)
+        assert teacher.dump()["fits"] == 10
+
+
+def self_paced_until_update(estimator):
+    teacher = small_teacher("Self-Paced")
+    teacher.set_value_estimator(estimator)
+    for _ in range(10):
+        task = teacher.sample_task()
+        teacher.record_initial_state(task, task)
+        teacher.step_update(task, [0.0], 1.0, task, True)
+    return teacher
+
+
+def test_self_paced_refuses_a_misbehaving_value_estimator():
+    with pytest.raises(ValueError, match="returned 9 values for 10 states"):
+        self_paced_until_update(lambda states: np.ones(len(states) - 1))
+    with pytest.raises(ValueError, match="returned 20 values for 10 states"):
+        self_paced_until_update(lambda states: np.ones((len(states), 2)))
+    with pytest.raises(ValueError, match="value 0 is nan"):
+        self_paced_until_update(lambda states: np.full(len(states), np.nan))
+
+    class Broken(Exception):
+        pass
+
+    def raises(states):
+        raise Broken("student not ready")
+
+    with pytest.raises(Broken, match="student not ready"):
+        self_paced_until_update(raises)
+    with pytest.raises(ValueError, match="no value estimator"):
+        self_paced_until_update(None)
