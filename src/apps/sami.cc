@@ -105,7 +105,9 @@ std::map<std::string, std::string> parse_hp(const std::vector<std::string>& pair
     if (eq == std::string::npos || eq == 0) {
       throw UserError("--hp '" + kv + "': expected name=value");
     }
-    out[kv.substr(0, eq)] = kv.substr(eq + 1);
+    // The same name twice would keep only one of the values, silently.
+    if (!out.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
+      throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
   }
   return out;
 }

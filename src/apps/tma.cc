@@ -394,7 +394,14 @@ void register_tma(CLI::App& app) {
           nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
     }
     if (ro.lr != 0) o.hyperparameters["learning_rate"] = std::to_string(ro.lr);
-    for (const std::string& kv : ro.hp) o.hyperparameters.insert(key_value("--hp", kv));
+    // The same name twice (or learning_rate with --lr) would keep only one value, silently.
+    for (const std::string& kv : ro.hp) {
+      const auto [k, v] = key_value("--hp", kv);
+      if (!o.hyperparameters.emplace(k, v).second)
+        throw UserError("--hp " + k + " is given twice" +
+                        (k == "learning_rate" && ro.lr != 0 ? " (also by --lr)" : "") +
+                        "; expected each name once");
+    }
     o.out = ro.out.empty() ? std::filesystem::path("tma_runs") / ro.exp_name /
                                  (ro.exp_name + "_s" + std::to_string(ro.seed))
                            : std::filesystem::path(ro.out);

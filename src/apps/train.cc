@@ -143,7 +143,9 @@ void register_train(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) {
         throw UserError("--hp '" + kv + "': expected name=value");
       }
-      opts->train.hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
+      // The same name twice would keep only one of the values, silently.
+      if (!opts->train.hyperparameters.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
+        throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
     }
     // Ctrl-C, or SIGTERM from srun, `cradle launch` or a scheduler's time limit, ends the run at
     // its next update with a checkpoint.
