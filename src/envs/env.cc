@@ -1,59 +1,95 @@
 #include "envs/env.h"
 
+#include <cstdint>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 
 #include "core/error.h"
 
 namespace cradle::envs {
 
 ObservationBuffers::ObservationBuffers(const DictSpace& space) {
-  size_t total = 0;
+  const size_t total = bytes_needed(space);
+  size_t offset = 0;
   for (const auto& [key, box] : space.entries) {
     // Every entry starts on a max_align_t boundary, so typed views are always aligned.
-    offsets_.push_back(total);
+    offsets_.push_back(offset);
     const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
     sizes_.push_back(bytes);
     dtypes_.push_back(box.dtype);
-    total += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
-             sizeof(std::max_align_t);
+    offset += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
+              sizeof(std::max_align_t);
   }
-  storage_.resize(total / sizeof(std::max_align_t) + 1);
+  storage_.resize(total / sizeof(std::max_align_t));
   // Value-initialising max_align_t zeroes its members, not its padding (the bytes after the
   // long double's 10): zero every byte so an entry nobody wrote reads 0, not stale heap.
   std::memset(storage_.data(), 0, storage_.size() * sizeof(std::max_align_t));
 }
 
+ObservationBuffers::ObservationBuffers(const DictSpace& space, std::span<std::byte> storage)
+    : ObservationBuffers(DictSpace{}) {
+  if (storage.size() < bytes_needed(space) ||
+      reinterpret_cast<std::uintptr_t>(storage.data()) % alignof(std::max_align_t) != 0) {
+    throw std::invalid_argument("ObservationBuffers: storage too small or misaligned");
+  }
+  size_t offset = 0;
+  for (const auto& [key, box] : space.entries) {
+    offsets_.push_back(offset);
+    const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
+    sizes_.push_back(bytes);
+    dtypes_.push_back(box.dtype);
+    offset += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
+              sizeof(std::max_align_t);
+  }
+  storage_.clear();
+  external_ = storage.data();
+}
+
+size_t ObservationBuffers::bytes_needed(const DictSpace& space) {
+  size_t total = 0;
+  for (const auto& [key, box] : space.entries) {
+    const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
+    total += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
+             sizeof(std::max_align_t);
+  }
+  return total + sizeof(std::max_align_t);
+}
+
+std::byte* ObservationBuffers::base() {
+  return external_ ? external_ : reinterpret_cast<std::byte*>(storage_.data());
+}
+const std::byte* ObservationBuffers::base() const {
+  return external_ ? external_ : reinterpret_cast<const std::byte*>(storage_.data());
+}
+
 namespace {
-template <typename T, typename Storage>
-std::span<T> view(Storage& storage, size_t offset, size_t bytes) {
-  auto* base =
-      reinterpret_cast<std::conditional_t<std::is_const_v<T>, const std::byte, std::byte>*>(
-          storage.data());
+template <typename T, typename Byte>
+std::span<T> view(Byte* base, size_t offset, size_t bytes) {
   return {reinterpret_cast<T*>(base + offset), bytes / sizeof(T)};
 }
 }  // namespace
 
 std::span<double> ObservationBuffers::f64(int i) {
-  return view<double>(storage_, offsets_[i], sizes_[i]);
+  return view<double>(base(), offsets_[i], sizes_[i]);
 }
 std::span<float> ObservationBuffers::f32(int i) {
-  return view<float>(storage_, offsets_[i], sizes_[i]);
+  return view<float>(base(), offsets_[i], sizes_[i]);
 }
 std::span<std::uint8_t> ObservationBuffers::u8(int i) {
-  return view<std::uint8_t>(storage_, offsets_[i], sizes_[i]);
+  return view<std::uint8_t>(base(), offsets_[i], sizes_[i]);
 }
 std::span<const double> ObservationBuffers::f64(int i) const {
-  return view<const double>(storage_, offsets_[i], sizes_[i]);
+  return view<const double>(base(), offsets_[i], sizes_[i]);
 }
 std::span<const float> ObservationBuffers::f32(int i) const {
-  return view<const float>(storage_, offsets_[i], sizes_[i]);
+  return view<const float>(base(), offsets_[i], sizes_[i]);
 }
 std::span<const std::uint8_t> ObservationBuffers::u8(int i) const {
-  return view<const std::uint8_t>(storage_, offsets_[i], sizes_[i]);
+  return view<const std::uint8_t>(base(), offsets_[i], sizes_[i]);
 }
 std::span<const std::byte> ObservationBuffers::bytes(int i) const {
-  return view<const std::byte>(storage_, offsets_[i], sizes_[i]);
+  return view<const std::byte>(base(), offsets_[i], sizes_[i]);
 }
 
 void Env::set_reset_options(const ResetOptions& options) {

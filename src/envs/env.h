@@ -22,6 +22,10 @@ namespace cradle::envs {
 class ObservationBuffers {
  public:
   explicit ObservationBuffers(const DictSpace& space);
+  // Views over `storage` that someone else owns (at least bytes_needed(space) bytes, aligned to
+  // max_align_t), e.g. shared memory that a process vector's worker writes.
+  ObservationBuffers(const DictSpace& space, std::span<std::byte> storage);
+  static size_t bytes_needed(const DictSpace& space);
   int count() const { return static_cast<int>(offsets_.size()); }
   std::span<double> f64(int index);
   std::span<float> f32(int index);
@@ -33,7 +37,11 @@ class ObservationBuffers {
   std::span<const std::byte> bytes(int index) const;
 
  private:
+  std::byte* base();
+  const std::byte* base() const;
+
   std::vector<std::max_align_t> storage_;
+  std::byte* external_ = nullptr;        // borrowed storage, when given
   std::vector<size_t> offsets_, sizes_;  // bytes
   std::vector<DType> dtypes_;
 };

@@ -8,8 +8,10 @@ namespace cradle::envs {
 TrainingLog::TrainingLog(std::filesystem::path file, int save_every, bool append, long episodes)
     : file_(std::move(file)),
       save_every_(save_every),
-      writer_(file_, append),
+      writer_(std::in_place, file_, append),
       episodes_(append ? episodes : 0) {}
+
+TrainingLog::TrainingLog(Relay relay) : save_every_(1), relay_(std::move(relay)) {}
 
 TrainingLog::~TrainingLog() {
   try {
@@ -23,6 +25,14 @@ void TrainingLog::record(const Info& info, int steps, double score, int slot) {
   nlohmann::json entry = info.to_json();
   entry["steps"] = steps;
   if (!std::isnan(score)) entry["score"] = score;
+  if (relay_) {
+    relay_(&entry);
+    return;
+  }
+  add(std::move(entry), slot);
+}
+
+void TrainingLog::add(nlohmann::json entry, int slot) {
   std::lock_guard lock(mutex_);
   entry["wall_time"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -35,8 +45,8 @@ void TrainingLog::record(const Info& info, int steps, double score, int slot) {
 }
 
 void TrainingLog::write_locked(const nlohmann::json& entry) {
-  writer_.write(entry);
-  if (++episodes_ % save_every_ == 0) writer_.flush();
+  writer_->write(entry);
+  if (++episodes_ % save_every_ == 0) writer_->flush();
 }
 
 void TrainingLog::set_slots(int slots) {
@@ -53,9 +63,13 @@ void TrainingLog::commit() {
 }
 
 void TrainingLog::flush() {
+  if (relay_) {
+    relay_(nullptr);
+    return;
+  }
   commit();
   std::lock_guard lock(mutex_);
-  writer_.flush();
+  writer_->flush();
 }
 
 long TrainingLog::episodes() const {

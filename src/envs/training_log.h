@@ -5,7 +5,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "core/config.h"
@@ -19,12 +21,19 @@ class TrainingLog {
   // append = false starts a new log (a new training run); true continues one (resume) that
   // already holds `episodes` entries.
   TrainingLog(std::filesystem::path file, int save_every, bool append = false, long episodes = 0);
+  // A relay, for an env that runs in another process than the run's log (a process vector's
+  // worker): record() hands each entry (without its wall time) to `relay`, and flush() hands it
+  // null; nothing is written here. The run's log takes them with add() and flush().
+  using Relay = std::function<void(const nlohmann::json* entry)>;
+  explicit TrainingLog(Relay relay);
   ~TrainingLog();
   // Records one finished episode of `steps` env steps with its task's score (NaN: none).
   // Thread-safe. With slots (a vector's envs), env `slot`'s entries wait for commit(), which
   // writes them in slot order, so the file's line order does not depend on which env thread
   // finished first.
   void record(const Info& info, int steps, double score, int slot = -1);
+  // Records an entry a relay recorded (record()'s, without the wall time, which is this log's).
+  void add(nlohmann::json entry, int slot = -1);
   // Ordered mode for `slots` envs (called before any record).
   void set_slots(int slots);
   // Writes the waiting entries of every slot, in slot order (call from one thread between steps).
@@ -39,7 +48,8 @@ class TrainingLog {
   std::filesystem::path file_;
   int save_every_;
   mutable std::mutex mutex_;
-  JsonlWriter writer_;
+  std::optional<JsonlWriter> writer_;  // none in a relay
+  Relay relay_;
   long episodes_ = 0;
   std::vector<std::vector<nlohmann::json>> pending_;  // per slot, waiting for commit()
   void write_locked(const nlohmann::json& entry);

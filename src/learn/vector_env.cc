@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "core/spin.h"
 #include "envs/action_check.h"
+#include "learn/proc_vector_env.h"
 
 namespace cradle::learn {
 namespace {
@@ -419,8 +420,10 @@ void set_after_reset(VecEnv& vec, std::function<void()> fn) {
     threaded->set_after_reset(std::move(fn));
   } else if (auto* async = dynamic_cast<AsyncVecEnv*>(&vec)) {
     async->set_after_reset(std::move(fn));
+  } else if (auto* procs = dynamic_cast<ProcVecEnv*>(&vec)) {
+    procs->set_after_reset(std::move(fn));
   } else {
-    throw std::invalid_argument("set_after_reset: not a ThreadedVecEnv or AsyncVecEnv");
+    throw std::invalid_argument("set_after_reset: not a ThreadedVecEnv, AsyncVecEnv or ProcVecEnv");
   }
 }
 

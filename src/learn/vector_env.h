@@ -199,8 +199,8 @@ class AsyncVecEnv final : public VecEnv {
   std::vector<std::thread> workers_;
 };
 
-// Sets the after-reset call of a ThreadedVecEnv or an AsyncVecEnv (std::invalid_argument for
-// another VecEnv).
+// Sets the after-reset call of a ThreadedVecEnv, an AsyncVecEnv or a ProcVecEnv
+// (std::invalid_argument for another VecEnv).
 void set_after_reset(VecEnv& vec, std::function<void()> fn);
 
 // The batch of an AsyncVecEnv as a VecEnv of batch.size() envs: env j is the batch's env ids[j]

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <functional>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -44,7 +46,7 @@ namespace {
 // The vector, and each env's BabyBench face (for the training log's bookkeeping).
 TrainingVector make_vector(const Config& config, int num_envs, int threads, bool training,
                            std::uint64_t seed, long continue_log, const EnvWrapper& wrap,
-                           int async_batch) {
+                           int async_batch, int procs = 0) {
   using learn::AsyncVecEnv;
   using learn::ThreadedVecEnv;
   if (num_envs < 1) throw std::invalid_argument("make_babybench_vec_env: num_envs < 1");
@@ -66,6 +68,49 @@ TrainingVector make_vector(const Config& config, int num_envs, int threads, bool
   };
   std::function<void()> commit;
   if (out.log) commit = [log = out.log] { log->commit(); };
+  if (procs > 0) {
+    // Each worker builds its envs (so the factory runs there); an env records its episodes in a
+    // relay log whose entries ("R<json>" lines, "F" for a flush) reach the run's log here.
+    auto outboxes = std::make_shared<std::vector<std::string>>(num_envs);
+    learn::ProcVecEnv::Channels channels;
+    if (out.log) {
+      channels.outbox = [outboxes](int i, std::string& message) {
+        std::swap(message, (*outboxes)[i]);
+      };
+      channels.inbox = [log = out.log](int i, std::string_view message) {
+        while (!message.empty()) {
+          const size_t end = message.find('\n');
+          const std::string_view line = message.substr(0, end);
+          if (line.starts_with('R')) {
+            log->add(nlohmann::json::parse(line.substr(1)), i);
+          } else {
+            log->flush();
+          }
+          message.remove_prefix(end == std::string_view::npos ? message.size() : end + 1);
+        }
+      };
+    }
+    channels.calls.push_back([envs](int i) { (*envs)[i]->end_episode(); });
+    auto make_in_worker = [&](int i) {
+      auto env = std::make_unique<envs::BabyBenchEnv>(assets, ThreadedVecEnv::env_seed(seed, i));
+      if (out.log) {
+        env->attach_log(std::make_shared<envs::TrainingLog>([outboxes, i](const nlohmann::json* e) {
+          std::string& box = (*outboxes)[i];
+          box += e ? "R" + e->dump() + "\n" : std::string("F\n");
+        }));
+      }
+      if (out.log && continue_log >= 0) env->skip_next_record();
+      (*envs)[i] = env.get();
+      return wrap ? wrap(std::move(env)) : std::unique_ptr<envs::Env>(std::move(env));
+    };
+    auto vec =
+        std::make_unique<learn::ProcVecEnv>(num_envs, make_in_worker, procs, std::move(channels));
+    vec->set_after_step(commit);
+    learn::ProcVecEnv* raw = vec.get();
+    out.end_episodes = [raw] { raw->call(0); };
+    out.vec = std::move(vec);
+    return out;
+  }
   // Async: the envs built here, in env order; its after-step call follows every batch.
   if (async_batch > 0) {
     std::vector<std::unique_ptr<envs::Env>> list;
@@ -95,11 +140,18 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
       make_vector(config, num_envs, threads, training, seed, continue_log, wrap, 0).vec.release()));
 }
 
+std::unique_ptr<learn::ProcVecEnv> make_babybench_proc_vec_env(const Config& config, int num_envs,
+                                                               int procs, bool training,
+                                                               std::uint64_t seed) {
+  return std::unique_ptr<learn::ProcVecEnv>(static_cast<learn::ProcVecEnv*>(
+      make_vector(config, num_envs, 0, training, seed, -1, nullptr, 0, procs).vec.release()));
+}
+
 TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
                                        std::uint64_t seed, long continue_log,
-                                       const EnvWrapper& wrap, int async_batch) {
+                                       const EnvWrapper& wrap, int async_batch, int procs) {
   return make_vector(config, num_envs, threads, /*training=*/true, seed, continue_log, wrap,
-                     async_batch);
+                     async_batch, procs);
 }
 
 }  // namespace cradle::train

@@ -8,6 +8,7 @@
 
 #include "core/config.h"
 #include "envs/training_log.h"
+#include "learn/proc_vector_env.h"
 #include "learn/vector_env.h"
 
 namespace cradle::train {
@@ -26,6 +27,13 @@ std::unique_ptr<learn::ThreadedVecEnv> make_babybench_vec_env(const Config& conf
                                                               long continue_log = -1,
                                                               const EnvWrapper& wrap = nullptr);
 
+// The same envs in `procs` worker processes (learn::ProcVecEnv; num_envs a multiple of procs), so
+// that envs which render draw in parallel; with training = true their training-log entries are
+// written here, by the one log, in env order.
+std::unique_ptr<learn::ProcVecEnv> make_babybench_proc_vec_env(const Config& config, int num_envs,
+                                                               int procs, bool training,
+                                                               std::uint64_t seed);
+
 // A training vector and its training log, for the run's bookkeeping without knowing the family.
 struct TrainingVector {
   // A ThreadedVecEnv (lock-step), or an AsyncVecEnv when built with async_batch > 0.
@@ -39,9 +47,11 @@ struct TrainingVector {
 // make_babybench_vec_env with training = true. continue_log >= 0 (a resumed run): the log holding
 // that many entries is continued and every env's first reset records nothing (the episode before
 // it was never this run's). async_batch > 0: an AsyncVecEnv returning batches of that many envs
-// (the same env seeds), whose log commits after every batch (env order within a commit).
+// (the same env seeds), whose log commits after every batch (env order within a commit). procs > 0:
+// a ProcVecEnv of that many worker processes (no async_batch then).
 TrainingVector make_babybench_training(const Config& config, int num_envs, int threads,
                                        std::uint64_t seed, long continue_log = -1,
-                                       const EnvWrapper& wrap = nullptr, int async_batch = 0);
+                                       const EnvWrapper& wrap = nullptr, int async_batch = 0,
+                                       int procs = 0);
 
 }  // namespace cradle::train

@@ -139,6 +139,19 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (options.steps < 1) throw UserError("--steps must be at least 1");
   if (options.envs < 1) throw UserError("--envs must be at least 1");
   if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
+  // Worker processes: each holds the same number of envs; their envs' teacher and batches would
+  // live apart from this process's.
+  if (options.procs != 0) {
+    if (options.procs < 1) throw UserError("--procs must be at least 1");
+    if (options.envs % options.procs != 0) {
+      throw UserError("--envs " + std::to_string(options.envs) +
+                      " does not split evenly over --procs " + std::to_string(options.procs) +
+                      "; give --envs a multiple of --procs");
+    }
+    if (!options.env.empty()) throw UserError("--procs is for BabyBench configs, not --env");
+    if (options.async_batch != 0) throw UserError("--procs and --async-batch: give one of them");
+    if (!options.task_space.empty()) throw UserError("--procs is not available with --task-space");
+  }
   // A sample env has none of BabyBench's extras.
   const bool sample = !options.env.empty();
   if (sample) {
@@ -266,7 +279,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
           ? make_sample_training(options.env, options.envs, options.threads, options.seed, wrap,
                                  options.async_batch)
           : make_babybench_training(env_config, options.envs, options.threads, options.seed + rank,
-                                    kept_episodes, wrap, options.async_batch);
+                                    kept_episodes, wrap, options.async_batch, options.procs);
   std::unique_ptr<VecEnv>& vec = training.vec;
   for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
     vec->env(i).set_reset_options({{"randomize_start", 1}});

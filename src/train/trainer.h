@@ -32,6 +32,9 @@ struct TrainOptions {
   // > 0: PPO and A2C collect through an AsyncVecEnv (`threads` workers) in batches of the first
   // async_batch envs to finish (1 <= async_batch < envs; docs/async.md); 0: lock-step.
   int async_batch = 0;
+  // > 0: the envs run in that many worker processes (learn::ProcVecEnv; envs a multiple of it), so
+  // that envs which render draw in parallel; 0: threads. BabyBench configs only.
+  int procs = 0;
   // LibTorch threads for gradient updates (LearnerOptions): 0: every core for image policies,
   // one for vector policies.
   int update_threads = 0;
