@@ -320,7 +320,12 @@ void OffPolicyLearner::learn_overlapped(long total_steps, const ProgressFn& on_p
     std::exception_ptr error;
     double seconds = 0;  // the collector's time of the last order
   } handoff;
+  // The collector computes with the learner thread's LibTorch thread count (torch_threads): a new
+  // thread starts at OpenMP's default, every core, and a different split of an operation may
+  // round differently, so the run would depend on the machine's core count.
+  const int torch_threads = torch::get_num_threads();
   auto collect = [&] {
+    const ScopedTorchThreads same_threads(torch_threads);
     std::unique_lock lock(handoff.mutex);
     while (true) {
       handoff.changed.wait(lock, [&] { return handoff.order > 0 || handoff.stop; });
