@@ -3,10 +3,12 @@
 // each episode's return and hidden parameters (optionally an mp4 and a PNG of the last frame);
 // `bench` measures env steps/s against the bare mj_steps replaying the env's controls; `info`
 // prints the spaces and the task sets of every split; `train` / `evaluate` / `table` train a
-// method, evaluate it on a split and tabulate runs as the paper's Table 1/2.
+// method, evaluate it on a split and tabulate runs as the paper's Table 1/2; `build-scene` writes
+// one task's model as MJCF.
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -21,6 +23,7 @@
 #include "eval/video.h"
 #include "sami/env.h"
 #include "sami/render.h"
+#include "sami/scene.h"
 #include "sami/task.h"
 #include "sami/throughput.h"
 #include "train/sami/sami_train.h"
@@ -42,6 +45,51 @@ std::string list(const std::vector<double>& values) {
 
 std::string cripple_text(const std::vector<int>& joints) {
   return "[" + sami::joints_text(joints, ",") + "]";
+}
+
+// The episode's hidden parameters, as `random` and `build-scene` print them.
+std::string hidden_text(const sami::Spec& spec, const sami::Info& info) {
+  if (spec.id == sami::EnvId::kPandaPush) {
+    return "friction " + eval_num(info.friction) + ", cube mass " + eval_num(info.mass);
+  }
+  return "mass x" + eval_num(info.mass) + ", damping x" + eval_num(info.damping) + ", crippled " +
+         cripple_text(info.crippled) +
+         (info.crippled.empty() || info.masked ? "" : " (geometry only)");
+}
+
+// Writes the model of task set `task` of the split (values drawn by a reset with `seed`) as
+// <out>/scene.xml. Every check comes before anything is written.
+void build_scene(const std::string& name, const std::string& split, int task, std::uint64_t seed,
+                 const std::string& out, bool overwrite) {
+  namespace fs = std::filesystem;
+  const sami::EnvId id = sami::env_from_name(name);
+  std::vector<sami::TaskSet> sets = sami::task_sets(id, split);
+  const int n = static_cast<int>(sets.size());
+  if (task < 0 || task >= n) {
+    throw UserError("--task " + std::to_string(task) + ": " + name + "'s split " + split +
+                    " has task sets 0 to " + std::to_string(n - 1));
+  }
+  const fs::path dir(out);
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+    throw UserError("--out " + out + " is a file; expected a folder");
+  }
+  if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !overwrite) {
+    throw UserError("--out " + out + " is not empty; pass --overwrite to replace its scene.xml");
+  }
+  auto env = sami::make_env(id, {std::move(sets[task])}, seed);
+  env->reset(seed);
+  const std::string xml = sami::scene_xml(*env);
+  fs::create_directories(dir, ec);
+  if (ec) throw UserError("cannot create folder '" + out + "': " + ec.message());
+  const fs::path file = dir / "scene.xml";
+  {
+    std::ofstream stream(file, std::ios::binary);
+    stream << xml;
+    if (!stream) throw UserError("cannot write '" + file.string() + "'");
+  }
+  std::printf("wrote %s: %s, split %s, task set %d, %s\n", file.string().c_str(), name.c_str(),
+              split.c_str(), task, hidden_text(env->spec(), env->info()).c_str());
 }
 
 void random_episodes(const std::string& name, const std::string& split, int episodes,
@@ -76,16 +124,13 @@ void random_episodes(const std::string& name, const std::string& split, int epis
       }
     } while (!r.terminated && !r.truncated && (max_steps == 0 || env->info().steps < max_steps));
     const sami::Info& info = env->info();
-    std::printf("episode %d: return %.3f, %d steps, task set %d", e, ret, info.steps,
-                info.task_set);
+    std::printf("episode %d: return %.3f, %d steps, task set %d, %s", e, ret, info.steps,
+                info.task_set, hidden_text(spec, info).c_str());
     if (spec.id == sami::EnvId::kPandaPush) {
-      std::printf(", friction %g, cube mass %g, success %d, skill %s\n", info.friction, info.mass,
-                  info.is_success, std::string(sami::skill_name(info.episode_skill)).c_str());
-    } else {
-      std::printf(", mass x%g, damping x%g, crippled %s%s\n", info.mass, info.damping,
-                  cripple_text(info.crippled).c_str(),
-                  info.crippled.empty() || info.masked ? "" : " (geometry only)");
+      std::printf(", success %d, skill %s", info.is_success,
+                  std::string(sami::skill_name(info.episode_skill)).c_str());
     }
+    std::printf("\n");
   }
   if (writer) {
     writer->close();
@@ -285,6 +330,33 @@ void register_sami(CLI::App& app) {
   });
 
   register_learners(*cmd);
+
+  struct SceneOptions {
+    std::string env, split = "train", out;
+    int task = 0;
+    std::uint64_t seed = 0;
+    bool overwrite = false;
+  };
+  auto scene_opts = std::make_shared<SceneOptions>();
+  CLI::App* scene = cmd->add_subcommand(
+      "build-scene",
+      "Write one task's model (hidden parameters applied) as <out>/scene.xml for MuJoCo's "
+      "simulate");
+  scene->add_option("--env", scene_opts->env, "Env name (see `cradle sami info --env all`)")
+      ->required();
+  scene->add_option("--split", scene_opts->split,
+                    "train, moderate, extreme or a task-set .yml file");
+  scene->add_option("--task", scene_opts->task,
+                    "Task set of the split, from 0 (`cradle sami info` lists them)");
+  scene->add_option("--seed", scene_opts->seed,
+                    "Seed of the reset that draws the task set's values");
+  scene->add_option("--out", scene_opts->out, "Output folder (new or empty)")->required();
+  scene->add_flag("--overwrite", scene_opts->overwrite,
+                  "Write into a folder that is not empty (replaces its scene.xml)");
+  scene->callback([scene_opts] {
+    const SceneOptions& o = *scene_opts;
+    build_scene(o.env, o.split, o.task, o.seed, o.out, o.overwrite);
+  });
 
   CLI::App* info = cmd->add_subcommand("info", "Spaces and task sets of an env");
   info->add_option("--env", opts->env, "Env name or all");

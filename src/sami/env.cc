@@ -90,7 +90,6 @@ Spec env_spec(EnvId id) {
       break;
     case Robot::kPanda:
       s.action_size = 4, s.horizon = 50, s.frame_skip = 20, s.dt = 0.04;
-      s.obs_dtype = DType::kFloat32;
       s.keys = {{"observation", 0, 19}, {"achieved_goal", 19, 3}, {"desired_goal", 22, 3}};
       s.obs_size = 25;
       return s;
@@ -107,7 +106,8 @@ SamiEnv::SamiEnv(Spec spec, ModelPtr shared, std::vector<TaskSet> sets, std::uin
       data_(mj_makeData(shared_.get()), mj_deleteData),
       sets_(std::move(sets)),
       obs_(spec_.obs_size, 0.0),
-      rng_(seed) {
+      rng_(seed),
+      obs32_(spec_.obs_size, 0.0f) {
   // The private parameter arrays start as copies of the shared model's.
   const mjModel* m = shared_.get();
   body_mass_.assign(m->body_mass, m->body_mass + m->nbody);
@@ -115,12 +115,14 @@ SamiEnv::SamiEnv(Spec spec, ModelPtr shared, std::vector<TaskSet> sets, std::uin
   dof_damping_.assign(m->dof_damping, m->dof_damping + m->nv);
   geom_size_.assign(m->geom_size, m->geom_size + 3 * m->ngeom);
   geom_friction_.assign(m->geom_friction, m->geom_friction + 3 * m->ngeom);
+  pair_friction_.assign(m->pair_friction, m->pair_friction + 5 * m->npair);
   geom_rgba_.assign(m->geom_rgba, m->geom_rgba + 4 * m->ngeom);
   model_.body_mass = body_mass_.data();
   model_.body_inertia = body_inertia_.data();
   model_.dof_damping = dof_damping_.data();
   model_.geom_size = geom_size_.data();
   model_.geom_friction = geom_friction_.data();
+  model_.pair_friction = pair_friction_.data();
   model_.geom_rgba = geom_rgba_.data();
   info_.crippled.reserve(8);
 }
@@ -140,6 +142,7 @@ const TaskSet& SamiEnv::begin_reset(std::optional<std::uint64_t> seed) {
   std::copy_n(m->dof_damping, dof_damping_.size(), dof_damping_.begin());
   std::copy_n(m->geom_size, geom_size_.size(), geom_size_.begin());
   std::copy_n(m->geom_friction, geom_friction_.size(), geom_friction_.begin());
+  std::copy_n(m->pair_friction, pair_friction_.size(), pair_friction_.begin());
   std::copy_n(m->geom_rgba, geom_rgba_.size(), geom_rgba_.begin());
   mj_resetData(&model_, data_.get());
   info_.task_set = static_cast<int>(rng_.next() % sets_.size());

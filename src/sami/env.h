@@ -37,7 +37,8 @@ struct Spec {
   std::string name;
   std::vector<ObsKey> keys;  // "observation" (+ "achieved_goal", "desired_goal" for Panda)
   int obs_size = 0;
-  DType obs_dtype = DType::kFloat64;  // what Gymnasium would see (Panda: float32)
+  // float32 as in the reference's gym envs (computed in double, rounded when written).
+  DType obs_dtype = DType::kFloat32;
   int action_size = 0;
   double action_low = -1, action_high = 1;  // the same bounds on every action entry
   int horizon = 0;                          // truncation after this many steps
@@ -86,13 +87,26 @@ class SamiEnv {
 
   const Spec& spec() const { return spec_; }
   // Starts an episode; a seed reseeds the env's generator, no seed continues its stream.
-  virtual void reset(std::optional<std::uint64_t> seed = std::nullopt) = 0;
-  // One env step; throws UserError for an action of the wrong size.
-  virtual StepResult step(std::span<const double> action) = 0;
-  std::span<const double> observation() const { return obs_; }
-  std::span<const double> observation(const ObsKey& key) const {
-    return std::span<const double>(obs_).subspan(key.offset, key.size);
+  void reset(std::optional<std::uint64_t> seed = std::nullopt) {
+    reset_episode(seed);
+    publish_observation();
   }
+  // One env step; throws UserError for an action of the wrong size.
+  StepResult step(std::span<const double> action) {
+    const StepResult r = step_episode(action);
+    publish_observation();
+    return r;
+  }
+  // The observation in float32, the reference's dtype: the double computation rounded.
+  std::span<const float> observation() const { return obs32_; }
+  std::span<const float> observation(const ObsKey& key) const {
+    return std::span<const float>(obs32_).subspan(key.offset, key.size);
+  }
+  // The observation as computed, in double, before the rounding (for tests and analysis).
+  std::span<const double> observation_f64() const { return obs_; }
+  // One factor per action entry that the crippling multiplies the action with (0: a masked
+  // actuator); empty when the env masks nothing.
+  virtual std::span<const double> action_mask() const { return {}; }
   const Info& info() const { return info_; }
   const std::vector<TaskSet>& task_sets() const { return sets_; }
 
@@ -104,6 +118,10 @@ class SamiEnv {
 
  protected:
   SamiEnv(Spec spec, ModelPtr shared, std::vector<TaskSet> sets, std::uint64_t seed);
+  // The family's episode start and step: they compute the observation into obs_ (double);
+  // reset() and step() round it to float32 afterwards.
+  virtual void reset_episode(std::optional<std::uint64_t> seed) = 0;
+  virtual StepResult step_episode(std::span<const double> action) = 0;
   void check_action(std::span<const double> action) const;
   // Draws the task set for the episode (uniformly) and restores the private arrays.
   const TaskSet& begin_reset(std::optional<std::uint64_t> seed);
@@ -114,12 +132,19 @@ class SamiEnv {
   ModelPtr shared_;
   mjModel model_;  // a header copy of *shared_ whose parameter arrays point at the vectors below
   std::unique_ptr<mjData, void (*)(mjData*)> data_;
-  std::vector<mjtNum> body_mass_, body_inertia_, dof_damping_, geom_size_, geom_friction_;
+  std::vector<mjtNum> body_mass_, body_inertia_, dof_damping_, geom_size_, geom_friction_,
+      pair_friction_;
   std::vector<float> geom_rgba_;
   std::vector<TaskSet> sets_;
-  std::vector<double> obs_;
+  std::vector<double> obs_;  // written by reset_episode / step_episode
   Info info_;
   Rng rng_;
+
+ private:
+  void publish_observation() {
+    for (size_t i = 0; i < obs_.size(); ++i) obs32_[i] = static_cast<float>(obs_[i]);
+  }
+  std::vector<float> obs32_;
 };
 
 // The spec of a named env (no model compiled).

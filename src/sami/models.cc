@@ -6,6 +6,8 @@
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/xml.h"
 
@@ -483,8 +485,8 @@ std::string panda() {
   // Elliptic friction cones: the pyramidal ones let a cube sink through a table of friction 10.
   x.leaf("option", {{"timestep", "0.002"}, {"gravity", "0 0 -9.81"}, {"cone", "elliptic"}});
   x.open("default");
-  // Arm links are visual only; the hand and the fingers (contype 2) touch the cube and table.
-  // Stiff contacts (time constant 2 timesteps) so a resting cube sinks well under 1 mm.
+  // Contacts come only from the explicit pairs below (contype 0 everywhere). Stiff contacts
+  // (time constant 2 timesteps) so a resting cube sinks well under 1 mm.
   x.leaf("geom", {{"contype", "0"},
                   {"conaffinity", "0"},
                   {"condim", "3"},
@@ -497,22 +499,18 @@ std::string panda() {
   light(x);
   x.leaf("camera",
          {{"name", "track"}, {"pos", "0.9 -0.9 0.7"}, {"xyaxes", ".707 .707 0 -.35 .35 .87"}});
-  // Contact bits: 1 table-cube, 2 fingers-table/cube, 4 ground-cube. The ground is a plane at its
-  // top face (z = -0.4); the hand never reaches the table or the cube and collides with nothing.
+  // Geom frictions are PyBullet's per-body lateral coefficients (the table's is set per task);
+  // the pairs below carry Bullet's products. The ground is a plane at its top face (z = -0.4).
   x.leaf("geom", {{"name", "ground"},
                   {"type", "plane"},
                   {"pos", "0 0 -.4"},
                   {"size", "3 3 .1"},
-                  {"contype", "4"},
-                  {"conaffinity", "4"},
-                  {"friction", ".25 0 0"},
+                  {"friction", ".5 0 0"},
                   {"material", "grid"}});
   x.leaf("geom", {{"name", "table"},
                   {"type", "box"},
                   {"pos", "-.3 0 -.2"},
                   {"size", ".55 .35 .2"},
-                  {"contype", "1"},
-                  {"conaffinity", "3"},
                   {"friction", "1 0 0"},
                   {"rgba", ".55 .45 .35 1"}});
   x.open("body", {{"name", "object"}, {"pos", "0 0 .02"}});
@@ -522,9 +520,7 @@ std::string panda() {
   x.leaf("geom", {{"name", "object"},
                   {"type", "box"},
                   {"size", ".02 .02 .02"},
-                  {"contype", "5"},
-                  {"conaffinity", "5"},
-                  {"friction", "1e-5 0 0"},
+                  {"friction", ".5 0 0"},
                   {"rgba", ".1 .8 .1 1"}});
   x.close();
   // The goal: a mocap body (moved per episode in mjData) with a visual-only box.
@@ -555,7 +551,11 @@ std::string panda() {
     x.leaf("inertial", {{"pos", nums(com)}, {"mass", num(mass)}, {"diaginertia", nums({i, i, i})}});
   };
   x.open("body", {{"name", "link0"}, {"pos", "-.6 0 0"}});
-  x.leaf("geom", {{"type", "cylinder"}, {"pos", "0 0 .06"}, {"size", ".06 .06"}});
+  x.leaf("geom", {{"name", "link0"},
+                  {"type", "cylinder"},
+                  {"pos", "0 0 .06"},
+                  {"size", ".06 .06"},
+                  {"friction", ".5 0 0"}});
   for (size_t k = 0; k < links.size(); ++k) {
     const Link& l = links[k];
     x.open("body", {{"name", l.name},
@@ -566,17 +566,26 @@ std::string panda() {
                      {"type", "hinge"},
                      {"axis", "0 0 1"},
                      {"range", nums(l.range)}});
-    // A capsule from the link origin towards its COM, for pictures.
-    x.leaf("geom", {{"type", "capsule"},
-                    {"fromto", nums({0, 0, 0, 2 * l.com[0], 2 * l.com[1], 2 * l.com[2]})},
-                    {"size", ".05"}});
+    // A capsule from the link origin towards its COM (the collision meshes are not in the
+    // sources); link7's stops 7 mm above the hand (at 0.107), which it must not swallow.
+    std::array<double, 3> end = {2 * l.com[0], 2 * l.com[1], 2 * l.com[2]};
+    if (k + 1 == links.size()) end = {0, 0, 0.05};
+    x.leaf("geom", {{"name", l.name},
+                    {"type", "capsule"},
+                    {"fromto", nums({0, 0, 0, end[0], end[1], end[2]})},
+                    {"size", ".05"},
+                    {"friction", ".5 0 0"}});
   }
   // link8 (fixed, +0.107 along z) and the hand (yaw -pi/4) as one body.
   x.open("body", {{"name", "hand"},
                   {"pos", "0 0 .107"},
                   {"quat", nums({std::cos(-M_PI / 8), 0, 0, std::sin(-M_PI / 8)})}});
   inertia(0.81, {0, 0, 0.04});
-  x.leaf("geom", {{"name", "hand"}, {"type", "box"}, {"pos", "0 0 .03"}, {"size", ".02 .09 .025"}});
+  x.leaf("geom", {{"name", "hand"},
+                  {"type", "box"},
+                  {"pos", "0 0 .03"},
+                  {"size", ".02 .09 .025"},
+                  {"friction", ".5 0 0"}});
   x.leaf("site",
          {{"name", "grasptarget"}, {"pos", "0 0 .105"}, {"size", ".005"}, {"rgba", "1 0 0 1"}});
   // Fingers: slides along the hand's +y (left) and -y (right); their inner faces are q apart from
@@ -596,9 +605,7 @@ std::string panda() {
                     {"type", "box"},
                     {"pos", nums({0, 0.008 * s, 0.03})},
                     {"size", ".01 .008 .02"},
-                    {"contype", "2"},
-                    {"conaffinity", "1"},
-                    {"friction", ".5 0 0"},
+                    {"friction", "1 0 0"},
                     {"rgba", ".3 .3 .3 1"}});
     x.close();
   }
@@ -606,6 +613,29 @@ std::string panda() {
   for (size_t k = 0; k < links.size(); ++k) x.close();
   x.close();  // link0
   x.close();  // worldbody
+  // PyBullet's contacts: every robot geom against the cube and the table (link0 stands on it),
+  // the cube against the table and the ground; no self-collision. Each pair's lateral friction is
+  // Bullet's product of the two geoms' coefficients, clipped at 10 (the env redoes the table's
+  // pairs at every reset); spinning and rolling friction are zero (condim 3).
+  x.open("contact");
+  const auto pair = [&](const std::string& a, const std::string& b, double mu) {
+    const std::string f = num(std::min(mu, 10.0));
+    x.leaf("pair", {{"geom1", a},
+                    {"geom2", b},
+                    {"condim", "3"},
+                    {"solref", ".004 1"},
+                    {"friction", f + " " + f + " 0 0 0"}});
+  };
+  std::vector<std::pair<std::string, double>> robot = {{"link0", 0.5}};
+  for (const Link& l : links) robot.emplace_back(l.name, 0.5);
+  robot.insert(robot.end(), {{"hand", 0.5}, {"leftfinger", 1.0}, {"rightfinger", 1.0}});
+  for (const auto& [geom, mu] : robot) {
+    pair(geom, "object", mu * 0.5);
+    if (geom != "link0") pair(geom, "table", mu * 1.0);
+  }
+  pair("object", "table", 0.5);
+  pair("object", "ground", 0.25);
+  x.close();
   x.open("actuator");
   // PyBullet's motors (§3.4) as velocity servos: the env sets ctrl = 50 (q* - q) every substep;
   // a stiff kv makes the velocity follow it, limited by the panda-gym motor forces.

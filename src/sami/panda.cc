@@ -27,10 +27,11 @@ int id_of(const mjModel* m, mjtObj type, const char* name) {
   return id;
 }
 
-// Bullet multiplies the two lateral frictions and clips at 10; the cube's own is 0.5.
-double effective_friction(double table) { return std::min(0.5 * table, 10.0); }
-
 }  // namespace
+
+double bullet_friction(double a, double b) { return std::min(a * b, 10.0); }
+
+namespace {}  // namespace
 
 PandaIk::PandaIk(const mjModel* m) : data_(mj_makeData(m), mj_deleteData), jac_(6 * m->nv) {
   site_ = id_of(m, mjOBJ_SITE, "grasptarget");
@@ -125,15 +126,22 @@ class PandaPush final : public SamiEnv {
     }
   }
 
-  void reset(std::optional<std::uint64_t> seed) override {
+  void reset_episode(std::optional<std::uint64_t> seed) override {
     const TaskSet& set = begin_reset(seed);
     const mjModel* m = &model_;
     mjData* d = data_.get();
-    // Task cell: table friction (Bullet's product rule) and cube mass with its box inertia.
+    // Task cell: table friction and cube mass with its box inertia. The geom frictions are
+    // Bullet's per-body coefficients; every contact pair of the table takes their product.
     const auto& cell = set.cells[rng_.next() % set.cells.size()];
     info_.friction = cell[0];
     info_.mass = cell[1];
-    geom_friction_[3 * table_] = effective_friction(cell[0]);
+    geom_friction_[3 * table_] = cell[0];
+    for (int p = 0; p < m->npair; ++p) {
+      const int a = m->pair_geom1[p], b = m->pair_geom2[p];
+      if (a != table_ && b != table_) continue;
+      pair_friction_[5 * p] = pair_friction_[5 * p + 1] =
+          bullet_friction(geom_friction_[3 * a], geom_friction_[3 * b]);
+    }
     body_mass_[cube_body_] = cell[1];
     for (int i = 0; i < 3; ++i) body_inertia_[3 * cube_body_ + i] = cell[1] * 2.667e-4;
     // Robot at the neutral pose, fingers closed, at rest; goal then cube on the table.
@@ -153,7 +161,7 @@ class PandaPush final : public SamiEnv {
     finish(false);
   }
 
-  StepResult step(std::span<const double> action) override {
+  StepResult step_episode(std::span<const double> action) override {
     check_action(action);
     const mjModel* m = &model_;
     mjData* d = data_.get();

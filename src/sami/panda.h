@@ -32,6 +32,10 @@ class PandaIk {
   double range_[7][2] = {};
 };
 
+// Bullet's combined lateral friction of a contact: the product of the two bodies' coefficients,
+// clipped at 10 (btManifoldResult). MuJoCo would take the larger one.
+double bullet_friction(double a, double b);
+
 // The per-step skill label of a state (after mj_forward or mj_step), from the cube height and its
 // contacts with the table and each finger.
 Skill panda_skill(const mjModel* m, const mjData* d);

@@ -16,8 +16,8 @@ SamiVector::SamiVector(EnvId id, std::vector<TaskSet> sets, std::uint64_t seed, 
   for (TaskSet& set : sets)
     envs_.push_back(make_env(id, {std::move(set)}, rng.derive(), model, options));
   const int n = size(), obs = spec().obs_size;
-  obs_.assign(n * obs, 0.0);
-  final_obs_.assign(n * obs, 0.0);
+  obs_.assign(n * obs, 0.0f);
+  final_obs_.assign(n * obs, 0.0f);
   rewards_.assign(n, 0.0);
   terminated_.assign(n, 0);
   truncated_.assign(n, 0);
@@ -60,8 +60,8 @@ void SamiVector::step(std::span<const double> actions) {
   });
 }
 
-std::span<const double> SamiVector::final_observation(int i) const {
-  return std::span<const double>(final_obs_).subspan(i * spec().obs_size, spec().obs_size);
+std::span<const float> SamiVector::final_observation(int i) const {
+  return std::span<const float>(final_obs_).subspan(i * spec().obs_size, spec().obs_size);
 }
 
 }  // namespace cradle::sami

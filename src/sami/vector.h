@@ -28,13 +28,13 @@ class SamiVector {
   // actions: size() rows of spec().action_size (row-major). Throws UserError on a wrong size.
   void step(std::span<const double> actions);
 
-  // size() rows of spec().obs_size: the observations after the step (after auto-reset).
-  std::span<const double> observations() const { return obs_; }
+  // size() rows of spec().obs_size: the float32 observations after the step (after auto-reset).
+  std::span<const float> observations() const { return obs_; }
   std::span<const double> rewards() const { return rewards_; }
   std::span<const std::uint8_t> terminated() const { return terminated_; }
   std::span<const std::uint8_t> truncated() const { return truncated_; }
   // The last observation and info of an episode that ended at the last step.
-  std::span<const double> final_observation(int i) const;
+  std::span<const float> final_observation(int i) const;
   const Info& final_info(int i) const { return final_info_[i]; }
   SamiEnv& env(int i) { return *envs_[i]; }
   const SamiEnv& env(int i) const { return *envs_[i]; }
@@ -43,7 +43,8 @@ class SamiVector {
   void copy_observation(int i);
   ThreadPool pool_;
   std::vector<std::unique_ptr<SamiEnv>> envs_;
-  std::vector<double> obs_, final_obs_, rewards_;
+  std::vector<float> obs_, final_obs_;
+  std::vector<double> rewards_;
   std::vector<std::uint8_t> terminated_, truncated_;
   std::vector<Info> final_info_;
 };

@@ -32,7 +32,46 @@ TEST(SamiAdapter, ForwardsSpacesObservationsAndSuccess) {
 
   auto cheetah = make_sami_env("HalfCheetah", "moderate", 0);
   cheetah->reset(2);
-  EXPECT_EQ(cheetah->observation().f64(0).size(), 18u);
+  EXPECT_EQ(cheetah->observation_space().entries[0].second.dtype, DType::kFloat32);
+  EXPECT_EQ(cheetah->observation().f32(0).size(), 18u);
+}
+
+// Every SaMI env publishes float32 observations, as the reference's gym envs: the values are the
+// env's double computation rounded once, and the adapter passes them on bit for bit.
+TEST(SamiObservations, AreTheDoubleComputationRoundedToFloat32) {
+  for (sami::EnvId id : sami::all_envs()) {
+    const std::string name(sami::env_name(id));
+    SCOPED_TRACE(name);
+    const std::string split = id == sami::EnvId::kCrippleHopper ? "extreme" : "train";
+    SamiEnvAdapter adapter(sami::make_env(name, split, 5));
+    EXPECT_EQ(adapter.sami().spec().obs_dtype, DType::kFloat32);
+    for (const auto& entry : adapter.observation_space().entries) {
+      EXPECT_EQ(entry.second.dtype, DType::kFloat32) << entry.first;
+    }
+    adapter.reset(9);
+    std::vector<double> action(adapter.action_space().size());
+    int rounded = 0;  // values that float32 cannot hold exactly
+    for (int t = 0; t < 5; ++t) {
+      for (size_t i = 0; i < action.size(); ++i) action[i] = std::sin(0.7 * t + i);
+      adapter.step(action);
+      const auto exact = adapter.sami().observation_f64();
+      const auto published = adapter.sami().observation();
+      ASSERT_EQ(exact.size(), published.size());
+      for (size_t i = 0; i < exact.size(); ++i) {
+        EXPECT_EQ(published[i], static_cast<float>(exact[i])) << i;
+        rounded += static_cast<double>(published[i]) != exact[i];
+      }
+      const auto& keys = adapter.sami().spec().keys;
+      for (size_t k = 0; k < keys.size(); ++k) {
+        const auto buffer = adapter.observation().f32(static_cast<int>(k));
+        for (int i = 0; i < keys[k].size; ++i) {
+          EXPECT_EQ(buffer[i], published[keys[k].offset + i]);
+        }
+      }
+    }
+    // The physics ran in double: most values lose digits in the rounding.
+    EXPECT_GT(rounded, 0);
+  }
 }
 
 // NaN and infinite actions are refused with the shared one-line error before any physics, for a

@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sami/env.h"
@@ -118,7 +122,7 @@ TEST(SamiPanda, RewardIsMinusTheGoalDistanceAndSuccessTerminates) {
   p.env->reset(4);
   const auto obs = p.env->observation();
   const std::array<double, 3> goal = {obs[22], obs[23], obs[24]};
-  EXPECT_DOUBLE_EQ(goal[2], 0.02);
+  EXPECT_EQ(goal[2], 0.02f);  // float32, as the reference's
   // Cube far from the goal: reward -distance, no success.
   const double far_x = goal[0] > 0 ? goal[0] - 0.2 : goal[0] + 0.2;
   p.place_cube(far_x, goal[1], 0.02);
@@ -165,7 +169,8 @@ TEST(SamiPanda, CellsSetTableFrictionAndCubeMassOnThePrivateModel) {
   const mjModel* m = p.env->model();
   const int table = mj_name2id(m, mjOBJ_GEOM, "table");
   const int cube = mj_name2id(m, mjOBJ_BODY, "object");
-  EXPECT_DOUBLE_EQ(m->geom_friction[3 * table], 10.0);  // 0.5 * 30 clipped at 10
+  EXPECT_DOUBLE_EQ(m->geom_friction[3 * table], 30.0);  // Bullet's coefficient of the table
+  EXPECT_DOUBLE_EQ(p.env->shared_model()->geom_friction[3 * table], 1.0);
   EXPECT_DOUBLE_EQ(m->body_mass[cube], 5.0);
   EXPECT_NEAR(m->body_inertia[3 * cube], 5 * 2.667e-4, 1e-12);
   EXPECT_DOUBLE_EQ(p.env->shared_model()->body_mass[cube], 1.0);
@@ -189,6 +194,124 @@ TEST(SamiPanda, SeededEpisodesAreDeterministic) {
     return trace;
   };
   EXPECT_EQ(run(), run());
+}
+
+// PyBullet's lateral coefficient of each Panda geom: the table's is the task's, the cube keeps the
+// default 0.5, panda-gym sets the fingers to 1.0, every other body has the default 0.5.
+double bullet_coefficient(const std::string& geom, double table) {
+  if (geom == "table") return table;
+  if (geom == "leftfinger" || geom == "rightfinger") return 1.0;
+  return 0.5;
+}
+
+std::string geom_name(const mjModel* m, int g) {
+  const char* name = mj_id2name(m, mjOBJ_GEOM, g);
+  return name ? name : "";
+}
+
+// The contacts of the current state as {geom, geom} (sorted names) -> lateral friction.
+std::map<std::pair<std::string, std::string>, std::array<double, 2>> contact_friction(
+    const mjModel* m, const mjData* d) {
+  std::map<std::pair<std::string, std::string>, std::array<double, 2>> out;
+  for (int i = 0; i < d->ncon; ++i) {
+    std::string a = geom_name(m, d->contact[i].geom1), b = geom_name(m, d->contact[i].geom2);
+    if (b < a) std::swap(a, b);
+    out[{a, b}] = {d->contact[i].friction[0], d->contact[i].friction[1]};
+  }
+  return out;
+}
+
+// Bullet multiplies the two bodies' frictions (clipped at 10), MuJoCo would take the larger: with
+// the fingers pressed on the table, the cube on it and the hand in the cube, every contact's
+// friction in mjData is the product, for every table friction of the task grid.
+TEST(SamiPanda, ContactFrictionIsBulletsProductForEveryPair) {
+  for (const double f : {0.1, 1.0, 5.0, 10.0, 30.0}) {
+    SCOPED_TRACE(f);
+    Panda p({f, 1.0});
+    p.env->reset(0);
+    const mjModel* m = p.env->model();
+    mjData* d = p.env->data();
+    const auto check = [&](const std::set<std::pair<std::string, std::string>>& expected) {
+      const auto contacts = contact_friction(m, d);
+      for (const auto& pair : expected)
+        EXPECT_TRUE(contacts.count(pair)) << pair.first << "-" << pair.second;
+      for (const auto& [pair, mu] : contacts) {
+        const double want =
+            std::min(bullet_coefficient(pair.first, f) * bullet_coefficient(pair.second, f), 10.0);
+        EXPECT_DOUBLE_EQ(mu[0], want) << pair.first << "-" << pair.second;
+        EXPECT_DOUBLE_EQ(mu[1], want) << pair.first << "-" << pair.second;
+      }
+    };
+    // Fingers 2 mm into the table, away from the cube.
+    PandaIk ik(m);
+    const mjtNum target[3] = {0, 0, 0.0034 - 0.002};  // fingertips are 3.4 mm below the target
+    mjtNum q[7];
+    ik.solve(m, d->qpos, target, q);
+    for (int k = 0; k < 7; ++k) d->qpos[ik.arm_qpos(k)] = q[k];
+    p.place_cube(0.1, 0.1, 0.0199);
+    check({{"leftfinger", "table"}, {"rightfinger", "table"}, {"object", "table"}});
+    // The cube inside the hand (above the fingers) and, separately, on a finger.
+    const int hand = mj_name2id(m, mjOBJ_GEOM, "hand");
+    const mjtNum* h = d->geom_xpos + 3 * hand;
+    p.place_cube(h[0], h[1], h[2]);
+    check({{"hand", "object"}});
+    const int finger = mj_name2id(m, mjOBJ_GEOM, "leftfinger");
+    // Outside the finger along its opening axis (the finger's local y), 2 mm into it.
+    const mjtNum* g = d->geom_xpos + 3 * finger;
+    const mjtNum* r = d->geom_xmat + 9 * finger;
+    p.place_cube(g[0] + 0.026 * r[1], g[1] + 0.026 * r[4], g[2] + 0.026 * r[7]);
+    check({{"leftfinger", "object"}});
+  }
+}
+
+// The arm's links and the hand collide with the table (only the fingers did): with the fingers
+// moved into the hand, a 200 N push drives the hand down onto the table, and it stays on top.
+TEST(SamiPanda, TheHandCannotPassThroughTheTable) {
+  const ModelPtr shared = compile_robot(Robot::kPanda);
+  mjModel* m = mj_copyModel(nullptr, shared.get());
+  for (const char* name : {"leftfinger", "rightfinger"}) {
+    const int g = mj_name2id(m, mjOBJ_GEOM, name);
+    m->geom_pos[3 * g + 2] = -0.03;  // inside the hand box
+    for (int i = 0; i < 3; ++i) m->geom_size[3 * g + i] = 1e-3;
+  }
+  mjData* d = mj_makeData(m);
+  PandaIk ik(m);
+  const mjtNum target[3] = {0.05, 0, 0.1};
+  mjtNum q[7];
+  ik.solve(m, d->qpos, target, q);
+  for (int k = 0; k < 7; ++k) d->qpos[ik.arm_qpos(k)] = q[k];
+  // The cube out of the way, in the table's far corner.
+  const int cube_qpos = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "object")];
+  d->qpos[cube_qpos] = 0.2, d->qpos[cube_qpos + 1] = 0.3;
+  const int hand_body = mj_name2id(m, mjOBJ_BODY, "hand");
+  const int hand = mj_name2id(m, mjOBJ_GEOM, "hand");
+  const int table = mj_name2id(m, mjOBJ_GEOM, "table");
+  // The lowest point of the hand box.
+  const auto bottom = [&] {
+    const mjtNum* r = d->geom_xmat + 9 * hand;
+    const mjtNum* half = m->geom_size + 3 * hand;
+    double z = d->geom_xpos[3 * hand + 2];
+    for (int k = 0; k < 3; ++k) z -= std::abs(r[6 + k]) * half[k];
+    return z;
+  };
+  mj_forward(m, d);
+  EXPECT_GT(bottom(), 0.1);
+  double lowest = 1;
+  bool touched = false;
+  for (int t = 0; t < 1000; ++t) {
+    d->xfrc_applied[6 * hand_body + 2] = -200;
+    mj_step(m, d);
+    lowest = std::min(lowest, bottom());
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      touched |= (c.geom1 == hand && c.geom2 == table) || (c.geom1 == table && c.geom2 == hand);
+    }
+  }
+  EXPECT_TRUE(touched);
+  EXPECT_GT(lowest, -0.005);  // a few millimetres of soft-contact penetration at most
+  EXPECT_LT(bottom(), 0.01);  // it did come down to the table
+  mj_deleteData(d);
+  mj_deleteModel(m);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <span>
 #include <vector>
 
 #include "core/error.h"
@@ -31,6 +32,13 @@ TEST(SamiVector, OneSubEnvPerTaskSetOnOneSharedModel) {
     EXPECT_TRUE(contains(sets[i].damping, vec.env(i).info().damping));
   }
   EXPECT_THROW(vec.step(std::vector<double>(5)), UserError);
+  // The vector's rows are the sub-envs' float32 observations, unchanged.
+  const std::span<const float> rows = vec.observations();
+  const int obs = vec.spec().obs_size;
+  for (int i = 0; i < vec.size(); ++i) {
+    const auto own = vec.env(i).observation();
+    EXPECT_TRUE(std::equal(own.begin(), own.end(), rows.begin() + i * obs)) << i;
+  }
 }
 
 TEST(SamiVector, AutoResetKeepsTheFinalObservationAndIsThreadCountInvariant) {
@@ -46,6 +54,9 @@ TEST(SamiVector, AutoResetKeepsTheFinalObservationAndIsThreadCountInvariant) {
         trace.push_back(vec.rewards()[i]);
         if (vec.truncated()[i]) {
           ++finished;
+          // The final observation is the ended episode's last (float32) one, not the reset's.
+          EXPECT_EQ(vec.final_observation(i).size(), 11u);
+          EXPECT_NE(vec.final_observation(i)[0], vec.env(i).observation()[0]);
           EXPECT_EQ(vec.final_info(i).steps, 1000);
           EXPECT_EQ(vec.env(i).info().steps, 0);  // already reset
         }

@@ -14,16 +14,11 @@ SamiEnvAdapter::SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env)
       success_slot_(info_.declare("is_success", InfoType::kBool)) {}
 
 void SamiEnvAdapter::copy_observation() {
-  // Key i of the family's flat observation goes to buffer i in its declared dtype.
+  // Key i of the family's flat float32 observation goes to buffer i.
   const auto& keys = env_->spec().keys;
   for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
     const auto values = env_->observation(keys[i]);
-    if (space_.entries[i].second.dtype == DType::kFloat32) {
-      std::transform(values.begin(), values.end(), buffers_.f32(i).begin(),
-                     [](double v) { return static_cast<float>(v); });
-    } else {
-      std::copy(values.begin(), values.end(), buffers_.f64(i).begin());
-    }
+    std::copy(values.begin(), values.end(), buffers_.f32(i).begin());
   }
   info_.steps = env_->info().steps;
   info_.set(success_slot_, env_->info().is_success);

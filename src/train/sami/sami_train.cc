@@ -69,7 +69,7 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
   if (!out) throw UserError("sami: cannot write " + file.string());
 }
 
-std::vector<float> to_float(std::span<const double> x) { return {x.begin(), x.end()}; }
+std::vector<float> to_vector(std::span<const float> x) { return {x.begin(), x.end()}; }
 
 std::string number(double v) {
   if (std::isnan(v)) return "";
@@ -198,8 +198,8 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   envs.reset(seed + static_cast<std::uint64_t>(steps));
   ContextSac::Streams streams = learner.streams(n);
   for (int i = 0; i < n; ++i) {
-    replay.begin(i, to_float(envs.observations().subspan(static_cast<size_t>(i) * spec.obs_size,
-                                                         spec.obs_size)));
+    replay.begin(i, envs.observations().subspan(static_cast<size_t>(i) * spec.obs_size,
+                                                spec.obs_size));
   }
 
   // Report accumulators.
@@ -231,8 +231,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     // Act: uniform random actions until learning_starts, then the policy with its contexts.
     {
       const auto o = envs.observations();
-      float* p = obs.data_ptr<float>();
-      for (size_t k = 0; k < o.size(); ++k) p[k] = static_cast<float>(o[k]);
+      std::copy(o.begin(), o.end(), obs.data_ptr<float>());
     }
     const torch::Tensor policy = learner.act(obs, streams, /*deterministic=*/false).first;
     if (steps < random_steps) {
@@ -259,11 +258,11 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     // Store the steps; finished trajectories close and new ones open.
     for (int i = 0; i < n; ++i) {
       const bool done = envs.terminated()[i] || envs.truncated()[i];
-      const auto row = [&](std::span<const double> x) {
-        return to_float(x.subspan(static_cast<size_t>(i) * spec.obs_size, spec.obs_size));
+      const auto row = [&](std::span<const float> x) {
+        return x.subspan(static_cast<size_t>(i) * spec.obs_size, spec.obs_size);
       };
-      const std::vector<float> next =
-          done ? to_float(envs.final_observation(i)) : row(envs.observations());
+      const std::span<const float> next =
+          done ? envs.final_observation(i) : row(envs.observations());
       replay.add(i,
                  std::span<const float>(taken + static_cast<size_t>(i) * spec.action_size,
                                         spec.action_size),
@@ -412,7 +411,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
       sami::StepResult r;
       std::vector<double> action(spec.action_size);
       do {
-        const torch::Tensor o = torch::tensor(to_float(env->observation())).unsqueeze(0);
+        const torch::Tensor o = torch::tensor(to_vector(env->observation())).unsqueeze(0);
         auto [a, c] = learner.act(o, streams, /*deterministic=*/true);
         const float* p = a.data_ptr<float>();
         for (int k = 0; k < spec.action_size; ++k) {
