@@ -56,6 +56,18 @@ class SamiEnv(_EnvBase):
     def step(self, action):
         return self._core.step(np.asarray(action, dtype=np.float64).reshape(-1))
 
+    @property
+    def model(self):
+        """Read-only numpy views of the env's MuJoCo model: this episode's hidden parameters
+        (body_mass, dof_damping, geom_size, geom_friction, pair_friction, ...), with the sizes
+        and body/joint/geom/actuator names."""
+        return self._core.model
+
+    @property
+    def data(self):
+        """Read-only numpy views of the env's mjData (qpos, qvel, xpos, ...); they follow the env."""
+        return self._core.data
+
     def render(self, width=320, height=240):
         if self.render_mode != "rgb_array":
             return None

@@ -83,3 +83,48 @@ def test_user_task_sets_from_yaml(tmp_path):
     path.write_text("task_sets:\n  - damping: [2.0]\n")
     with pytest.raises(ValueError, match="does not vary damping"):
         cradle.sami.make("CrippleWalker", split=str(path))
+
+
+@pytest.mark.parametrize("name", cradle.sami.ENV_NAMES)
+def test_observations_are_float32_like_the_reference(name):
+    env = cradle.sami.make(name)
+    for key, space in env.observation_space.spaces.items():
+        assert space.dtype == np.float32, key
+    obs, _ = env.reset(seed=4)
+    assert all(value.dtype == np.float32 for value in obs.values())
+    obs, *_ = env.step(np.full(env.action_space.shape, 0.1))
+    assert all(value.dtype == np.float32 for value in obs.values())
+    assert env.observation_space.contains(obs)
+
+
+def test_model_and_data_are_read_only_views_of_the_episode(tmp_path):
+    path = tmp_path / "sets.yml"
+    path.write_text("task_sets:\n  - mass: [2.0]\n    cripple: [[0]]\n")
+    heavy = cradle.sami.make("CrippleAnt", split=str(path))
+    heavy.reset(seed=0)
+    path.write_text("task_sets:\n  - mass: [1.0]\n")
+    plain = cradle.sami.make("CrippleAnt", split=str(path))
+    plain.reset(seed=0)
+    model, data = heavy.model, heavy.data
+    assert model.nbody == plain.model.nbody and model.body_names[0] == "world"
+    # The views show this episode's hidden parameters: every mass doubled, leg 0 shrunk.
+    np.testing.assert_allclose(model.body_mass[1:], 2.0 * plain.model.body_mass[1:])
+    shrunk = model.geom_size[:, 0] < plain.model.geom_size[:, 0]
+    assert shrunk.sum() == 2
+    np.testing.assert_allclose(model.geom_size[shrunk], 0.5 * plain.model.geom_size[shrunk])
+    views = [model.body_mass, model.geom_size, model.dof_damping, model.actuator_gear,
+             data.qpos, data.qvel, data.xpos, data.ctrl]
+    for view in views:
+        assert not view.flags.writeable
+        with pytest.raises(ValueError):
+            view[0] = 1.0
+    # Data views follow the env and keep it alive.
+    qpos = data.qpos
+    before = qpos.copy()
+    heavy.step(np.full(8, 0.5))
+    assert not np.array_equal(qpos, before)
+    assert heavy.data.time > 0
+    del heavy, data, model
+    import gc
+    gc.collect()
+    assert np.isfinite(qpos).all() and np.isfinite(views[0]).all()
