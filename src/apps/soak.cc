@@ -1,9 +1,9 @@
-// `cradle soak --config FILE [--steps N] [--envs N] [--threads T] [--eval-every N] ...`: the
-// long-running vision soak (issue 19, item 0). Random actions drive a vector of envs on a thread
-// pool for N env steps; every --eval-every steps an evaluation env with its video renderer is
-// built, run and destroyed on the main thread while the vector's contexts live (the train ->
-// evaluation transition that crashed), and the run ends with an evaluation with video. It prints
-// progress, steps/s and the resident memory, and exits 0 only when everything finished.
+// `cradle soak --config FILE [--steps N] [--envs N] [--threads T | --procs P] [--eval-every N]
+// ...`: the long-running vision soak. Random actions drive a vector of envs on a thread pool (or
+// in worker processes) for N env steps; every --eval-every steps an evaluation env with its video
+// renderer is built, run and destroyed on the main thread while the vector's contexts live (the
+// train -> evaluation transition that crashed), and the run ends with an evaluation with video. It
+// prints progress, steps/s and the resident memory, and exits 0 only when everything finished.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -44,6 +44,7 @@ void register_soak(CLI::App& app) {
     long steps = 500000;
     int envs = 2;
     int threads = 0;
+    int procs = 0;
     long eval_every = 100000;
     int eval_episodes = 1;
     int eval_duration = 1000;
@@ -60,6 +61,9 @@ void register_soak(CLI::App& app) {
   cmd->add_option("--envs", opts->envs, "Parallel envs")->check(CLI::Range(1, 1024));
   cmd->add_option("--threads", opts->threads, "Worker threads (0: one per env, <= cores)")
       ->check(CLI::Range(0, 1024));
+  cmd->add_option("--procs", opts->procs,
+                  "Run the envs in N worker processes (--envs a multiple of N) instead of threads")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--eval-every", opts->eval_every,
                   "Env steps between evaluations run beside the live vector")
       ->check(CLI::Range(1L, 100000000000L));
@@ -95,8 +99,14 @@ void register_soak(CLI::App& app) {
     const Clock::time_point start = Clock::now();
     long steps = 0;
     {
-      auto vec = train::make_babybench_vec_env(config, opts->envs, opts->threads,
-                                               /*training=*/false, opts->seed);
+      std::unique_ptr<learn::VecEnv> vec;
+      if (opts->procs > 0) {
+        vec = train::make_babybench_proc_vec_env(config, opts->envs, opts->procs,
+                                                 /*training=*/false, opts->seed);
+      } else {
+        vec = train::make_babybench_vec_env(config, opts->envs, opts->threads,
+                                            /*training=*/false, opts->seed);
+      }
       const int n = vec->num_envs();
       const Box& space = vec->action_space();
       std::vector<double> actions(static_cast<size_t>(n) * space.size());
@@ -131,8 +141,10 @@ void register_soak(CLI::App& app) {
     evaluate("after the vector");
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf(
-        "soak finished: %ld env steps on %d envs, %d evaluations, %.0f s, peak RSS %.0f MB\n",
-        steps, opts->envs, evaluations, seconds, resident_mb().second);
+        "soak finished: %ld env steps on %d envs%s, %d evaluations, %.0f s, peak RSS %.0f MB\n",
+        steps, opts->envs,
+        opts->procs > 0 ? (" in " + std::to_string(opts->procs) + " processes").c_str() : "",
+        evaluations, seconds, resident_mb().second);
   });
 }
 

@@ -72,6 +72,10 @@ void register_train(CLI::App& app) {
   cmd->add_option("--envs", opts->train.envs, "Parallel envs")->check(CLI::Range(1, 1024));
   cmd->add_option("--threads", opts->train.threads, "Worker threads (0: one per env, <= cores)")
       ->check(CLI::Range(0, 1024));
+  cmd->add_option("--procs", opts->train.procs,
+                  "Run the envs in N worker processes (--envs a multiple of N): envs that render "
+                  "draw in parallel")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--async-batch", opts->train.async_batch,
                   "PPO/A2C: collect asynchronously in batches of the first K envs (K < --envs)")
       ->check(CLI::Range(1, 1024));
