@@ -29,12 +29,15 @@ else:
 
 
 class VectorEnv(_VectorBase):
-    """num_envs BabyBench envs of one config on a C++ thread pool.
+    """num_envs BabyBench envs of one config on a C++ thread pool, or in worker processes.
 
     Args:
       config: dict, YAML path or parsed config.
       num_envs: number of envs.
       threads: pool participants (0: one per env, at most the cores; 1: the calling thread only).
+      procs: 0 (threads), or run the envs in that many worker processes (num_envs a multiple of
+        it), so that envs which render draw in parallel. Make such a vector before anything in
+        this process renders.
       training: prepare save_dir and log every episode of every env in one training log.
       seed: seed used by reset() without a seed (and of the seeds it draws afterwards).
       autoreset_mode: "next_step" (Gymnasium's default) or "same_step" (an ended env is reset in
@@ -42,14 +45,16 @@ class VectorEnv(_VectorBase):
     """
 
     def __init__(self, config, num_envs, threads=0, training=False, seed=0,
-                 autoreset_mode="next_step"):
+                 autoreset_mode="next_step", procs=0):
         if autoreset_mode not in ("next_step", "same_step"):
             raise ValueError("autoreset_mode must be 'next_step' or 'same_step'")
         if not isinstance(num_envs, numbers.Integral) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, not {num_envs!r}")
+        if not isinstance(procs, numbers.Integral) or procs < 0:
+            raise ValueError(f"procs must be a non-negative integer, not {procs!r}")
         self._config = load_config(config)
         self._core = _cradle.VecEnv(self._config, int(num_envs), int(threads), bool(training),
-                                    int(seed), autoreset_mode == "same_step")
+                                    int(seed), autoreset_mode == "same_step", int(procs))
         self.num_envs = int(num_envs)
         self.single_observation_space = spaces.from_core_dict(self._core.observation_space)
         self.single_action_space = spaces.from_core_box(self._core.action_space)
@@ -78,6 +83,11 @@ class VectorEnv(_VectorBase):
     @property
     def threads(self):
         return self._core.threads
+
+    @property
+    def procs(self):
+        """Worker processes (0: the envs run on threads)."""
+        return self._core.procs
 
     def reset(self, *, seed=None, options=None):
         """Resets every env: (observations, infos). Env i gets the i-th seed derived from `seed`

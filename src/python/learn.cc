@@ -42,26 +42,37 @@ py::array object_array(std::vector<py::object> items) {
 
 }  // namespace
 
-// N BabyBench envs stepped by C++ threads, with batched numpy observations. next-step autoreset
-// (Gymnasium 1.x's default) or, with same_step, Stable-Baselines3's convention: an env whose
-// episode ends is reset in the same call, its last observation and info kept in the infos as
-// "final_obs" / "final_info".
+// N BabyBench envs stepped by C++ threads (or worker processes), with batched numpy observations.
+// Next-step autoreset (Gymnasium 1.x's default) or, with same_step, Stable-Baselines3's
+// convention: an env whose episode ends is reset in the same call, its last observation and info
+// kept in the infos as "final_obs" / "final_info".
 class PyVecEnv {
  public:
+  // procs > 0: the envs in that many worker processes (learn::ProcVecEnv) instead of threads.
   PyVecEnv(const Config& config, int num_envs, int threads, bool training, std::uint64_t seed,
-           bool same_step)
+           bool same_step, int procs)
       : same_step_(same_step) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1");
+    if (procs < 0) throw py::value_error("procs must be 0 (threads) or more");
     {
       py::gil_scoped_release release;
-      vec_ = train::make_babybench_vec_env(config, num_envs, threads, training, seed);
+      if (procs > 0) {
+        auto vec = train::make_babybench_proc_vec_env(config, num_envs, procs, training, seed);
+        procs_ = vec.get();
+        vec_ = std::move(vec);
+      } else {
+        auto vec = train::make_babybench_vec_env(config, num_envs, threads, training, seed);
+        threaded_ = vec.get();
+        vec_ = std::move(vec);
+      }
     }
     entries_ = entries_of(vec_->observation_space());
   }
 
   int num_envs() const { return vec_->num_envs(); }
-  int threads() const { return vec_->threads(); }
-  learn::ThreadedVecEnv& vec() { return *vec_; }
+  int threads() const { return threaded_ ? threaded_->threads() : 0; }
+  int procs() const { return procs_ ? procs_->procs() : 0; }
+  learn::VecEnv& vec() { return *vec_; }
 
   py::tuple reset(std::uint64_t seed) {
     py::dict obs = allocate();
@@ -118,7 +129,7 @@ class PyVecEnv {
       }
       {
         py::gil_scoped_release release;
-        if (any_ended) vec_->reset_ended();
+        if (any_ended) threaded_ ? threaded_->reset_ended() : procs_->reset_ended();
         gather();
       }
       info = infos();
@@ -236,7 +247,9 @@ class PyVecEnv {
   }
 
   bool same_step_;
-  std::unique_ptr<learn::ThreadedVecEnv> vec_;
+  std::unique_ptr<learn::VecEnv> vec_;
+  learn::ThreadedVecEnv* threaded_ = nullptr;  // one of these two is vec_
+  learn::ProcVecEnv* procs_ = nullptr;
   std::vector<Entry> entries_;
   std::vector<std::byte*> pointers_;
   double stepping_ = 0;
@@ -337,10 +350,11 @@ struct PyPolicy {
 }  // namespace
 
 void bind_learn(py::module_& m) {
-  py::class_<PyVecEnv>(m, "VecEnv", "BabyBench envs stepped by C++ threads (use cradle.VectorEnv).")
-      .def(py::init<const Config&, int, int, bool, std::uint64_t, bool>(), py::arg("config"),
+  py::class_<PyVecEnv>(m, "VecEnv",
+                       "BabyBench envs stepped by C++ threads or processes (use cradle.VectorEnv).")
+      .def(py::init<const Config&, int, int, bool, std::uint64_t, bool, int>(), py::arg("config"),
            py::arg("num_envs"), py::arg("threads") = 0, py::arg("training") = false,
-           py::arg("seed") = 0, py::arg("same_step") = false)
+           py::arg("seed") = 0, py::arg("same_step") = false, py::arg("procs") = 0)
       .def("reset", &PyVecEnv::reset, py::arg("seed"))
       .def("step", &PyVecEnv::step, py::arg("actions"))
       .def("bench", &PyVecEnv::bench, py::arg("actions"))
@@ -350,6 +364,7 @@ void bind_learn(py::module_& m) {
       .def("close", &PyVecEnv::close)
       .def_property_readonly("num_envs", &PyVecEnv::num_envs)
       .def_property_readonly("threads", &PyVecEnv::threads)
+      .def_property_readonly("procs", &PyVecEnv::procs)
       .def_property_readonly("observation_space",
                              [](PyVecEnv& v) { return space_list(v.vec().observation_space()); })
       .def_property_readonly("action_space",

@@ -5,7 +5,9 @@
 #include <GL/gl.h>
 #include <GL/osmesa.h>
 #include <dlfcn.h>
+#include <pthread.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -327,7 +329,24 @@ std::unique_ptr<GlContext> GlContext::create(int max_width, int max_height) {
   }
 }
 
+namespace {
+
+// Set in a child forked from a process that had made a GL context: Mesa's per-process state
+// (llvmpipe's threads among it) does not survive a fork, and a context made there hangs. Like
+// gl_mutex(), process state by nature.
+std::atomic<bool> forked_after_gl{false};
+
+}  // namespace
+
 std::unique_ptr<GlContext> GlContext::create(GlBackend backend, int max_width, int max_height) {
+  static const bool watching_forks =
+      pthread_atfork(nullptr, nullptr, [] { forked_after_gl.store(true); }) == 0;
+  (void)watching_forks;
+  if (forked_after_gl.load()) {
+    throw UserError(
+        "this process was forked from one that had already rendered, and GL does not survive "
+        "a fork: make process vectors before anything renders");
+  }
   const std::lock_guard lock(gl_mutex());
   require_platform(backend);
   if (backend == GlBackend::kEgl) return std::make_unique<EglContext>();

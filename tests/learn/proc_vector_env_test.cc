@@ -137,7 +137,8 @@ TEST(ProcVecEnv, SameTrajectoriesAsTheThreadVector) {
 }
 
 // With vision: each worker renders with its own GL context. The workers start before this
-// process renders (Mesa's state does not survive a fork).
+// process renders (Mesa's state does not survive a fork; ctest runs each test in a process of
+// its own).
 TEST(ProcVecEnv, SameTrajectoriesWithVision) {
   const Config config = config_of("config_handregard.yml", 15);
   ASSERT_TRUE(config.vision_active);
@@ -255,6 +256,22 @@ TEST(ProcVecEnv, CleanShutdownReapsEveryWorker) {
   }
   ASSERT_EQ(pids.size(), 3u);
   for (pid_t pid : pids) EXPECT_TRUE(gone(pid)) << pid;
+}
+
+// A process that has rendered cannot fork workers that render (Mesa's state does not survive a
+// fork): a worker's env says so in one line instead of hanging. Last here: this process renders.
+TEST(ProcVecEnv, RefusesToRenderInWorkersOfAProcessThatRendered) {
+  const Config config = config_of("config_handregard.yml", 10);
+  const auto threads = train::make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
+  threads->reset(0);
+  try {
+    train::make_babybench_proc_vec_env(config, 2, 2, /*training=*/false, 0);
+    FAIL() << "workers were forked after rendering";
+  } catch (const UserError& e) {
+    EXPECT_STREQ(e.what(),
+                 "this process was forked from one that had already rendered, and GL does not "
+                 "survive a fork: make process vectors before anything renders");
+  }
 }
 
 }  // namespace

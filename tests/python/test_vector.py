@@ -64,3 +64,32 @@ def test_vector_rejects_bad_input(make_config):
         vec.step(np.zeros((2, 29)))
     with pytest.raises(ValueError):
         cradle.VectorEnv(make_config("selftouch"), num_envs=0)
+
+
+def test_worker_processes_give_the_thread_vectors_batches(make_config):
+    config = make_config("selftouch", max_episode_steps=4)
+    runs = []
+    for procs in (0, 2):
+        vec = cradle.VectorEnv(config, num_envs=4, threads=2, procs=procs)
+        assert vec.procs == procs
+        obs, infos = vec.reset(seed=7)
+        rng = np.random.default_rng(1)
+        seen = [(obs, infos)]
+        for _ in range(10):
+            space = vec.single_action_space
+            seen.append(vec.step(rng.uniform(space.low, space.high, (4, 30))))
+        runs.append(seen)
+        vec.close()
+    for a, b in zip(*runs):
+        for x, y in zip(a, b):
+            if isinstance(x, dict):
+                assert x.keys() == y.keys()
+                for key in x:
+                    if x[key].dtype == object:
+                        assert [list(v) for v in x[key]] == [list(v) for v in y[key]]
+                    else:
+                        np.testing.assert_array_equal(x[key], y[key])
+            else:
+                np.testing.assert_array_equal(x, y)
+    with pytest.raises(ValueError, match="3 envs do not split evenly over 2 processes"):
+        cradle.VectorEnv(config, num_envs=3, procs=2)
