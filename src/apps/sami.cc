@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/interrupt.h"
 #include "core/error.h"
@@ -174,7 +175,7 @@ void register_learners(CLI::App& cmd) {
                                     "SaCCMAll) on an env's training task sets");
   tr->add_option("--env", opts->train.env, "Env name (see `cradle sami info --env all`)");
   tr->add_option("--method", opts->train.method, "TESAC, CCM, SaTESAC, SaCCM or SaCCMAll");
-  tr->add_option("--seed", opts->train.seed, "Seed");
+  tr->add_option("--seed", opts->train.seed, "Seed")->check(kSeed);
   tr->add_option("--steps-per-env", opts->train.steps_per_env,
                  "Env steps per training env (default 500000; PandaPush 1000000)")
       ->check(CLI::Range(1L, 10'000'000'000L));
@@ -207,7 +208,7 @@ void register_learners(CLI::App& cmd) {
   ev->add_option("--split", opts->eval.split, "train, moderate or extreme");
   ev->add_option("--episodes", opts->eval.episodes, "Episodes per task set (cell)")
       ->check(CLI::Range(1, 100000));
-  ev->add_option("--seed", opts->eval.seed, "Seed of the evaluation envs");
+  ev->add_option("--seed", opts->eval.seed, "Seed of the evaluation envs")->check(kSeed);
   ev->add_flag("--video", opts->eval.video, "Write eval_<split>.mp4 (first episode per cell)");
   ev->callback([opts] {
     opts->eval.run = opts->run;
@@ -273,7 +274,7 @@ void register_sami(CLI::App& app) {
   random->add_option("--env", opts->env, "Env name (see `cradle sami info --env all`)");
   random->add_option("--split", opts->split, "train, moderate, extreme or a task-set .yml file");
   random->add_option("--episodes", opts->episodes, "Episodes")->check(CLI::Range(1, 100000));
-  random->add_option("--seed", opts->seed, "Seed of the env and the random policy");
+  random->add_option("--seed", opts->seed, "Seed of the env and the random policy")->check(kSeed);
   random->add_option("--video", opts->video, "Write an mp4 of all episodes");
   random->add_option("--png", opts->png, "Write a PNG of the last frame");
   random->add_option("--size", opts->size, "Picture width (height 3/4 of it)")
@@ -292,7 +293,7 @@ void register_sami(CLI::App& app) {
   bench->add_option("--env", opts->env, "Env name or all");
   bench->add_option("--steps", opts->steps, "Env steps per env")
       ->check(CLI::Range(100L, 100000000L));
-  bench->add_option("--seed", opts->seed, "Seed of the env and the random actions");
+  bench->add_option("--seed", opts->seed, "Seed of the env and the random actions")->check(kSeed);
   bench->add_flag("--json", opts->json, "Print one JSON array");
   bench->callback([opts] {
     const std::vector<sami::EnvId> ids = envs_named(opts->env);

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/interrupt.h"
 #include "apps/tma_bench.h"
@@ -224,7 +225,7 @@ void register_tma(CLI::App& app) {
   random->add_option("--task", ro->tasks, "Task parameter name=value[,v2,v3] (repeatable)");
   random->add_option("--video", ro->video, "Write the episode to this .mp4 / .avi");
   random->add_option("--steps", ro->steps, "Episode step cap")->check(CLI::Range(1, 1000000));
-  random->add_option("--seed", ro->seed, "Seed of the env and the policy");
+  random->add_option("--seed", ro->seed, "Seed of the env and the policy")->check(kSeed);
   random->add_flag("--movable-creepers", ro->movable_creepers, "Parkour: dynamic creepers");
   random->add_flag("--lidars", ro->lidars, "Draw the lidar rays in the video");
   random->add_option("--png", ro->png, "Save the frame after --png-step steps as PNG");
@@ -293,7 +294,7 @@ void register_tma(CLI::App& app) {
   bench->add_option("--env", bo->env, "stump-tracks | parkour");
   bench->add_option("--embodiment", bo->body, "Embodiment, or all");
   bench->add_option("--steps", bo->steps, "Steps timed")->check(CLI::Range(100, 100000000));
-  bench->add_option("--seed", bo->seed, "Seed");
+  bench->add_option("--seed", bo->seed, "Seed")->check(kSeed);
   bench->add_flag("--json", bo->json, "JSON output");
   bench->callback([bo] {
     const tma::EnvId id = tma::parse_env_id(bo->env);
@@ -352,7 +353,7 @@ void register_tma(CLI::App& app) {
                   "the grid (Stump Tracks) or 100 fixed uniform tasks");
   run->add_option("--nb_test_episodes,--nb_test_episode", rn->nb_test_episodes,
                   "Size of the default test set");
-  run->add_option("--seed", rn->seed, "Seed of the student, teacher and shuffling");
+  run->add_option("--seed", rn->seed, "Seed of the student, teacher and shuffling")->check(kSeed);
   run->add_option("--keep_periodical_task_samples", rn->keep_periodical_task_samples,
                   "Env steps between 100-task curriculum snapshots (0: none)");
   run->add_flag("--shuffle_dimensions", rn->shuffle_dimensions, "Rugged difficulty (4x4)");

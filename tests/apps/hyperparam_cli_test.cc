@@ -69,6 +69,23 @@ TEST(HyperparamCli, TmaRunRefusesEmptyOrShortListsSizesBeyondMemoryAndRepeatedNa
   fs::remove_all(dir);
 }
 
+// Seeds of tma and sami runs are decimal integers from 0 to 2^64 - 1, as train's: -1 wrapped to
+// 2^64 - 1, 2^64 saturated and 0x10 read as 16.
+TEST(HyperparamCli, TmaAndSamiSeedsAreDecimalIn64Bits) {
+  const fs::path dir = cradle::test::fresh_dir("hp_seeds");
+  const std::string out = " --no-progress --out " + (dir / "run").string();
+  for (const char* seed : {"-1", "18446744073709551616", "0x10", "1.5", "abc"}) {
+    const std::string flag = std::string(" --seed ") + seed;
+    expect_error("tma run --env stump-tracks --student sac --teacher Random --nb_env_steps 0.0002" +
+                     out + flag,
+                 "seed");
+    expect_error("sami train --env PandaPush --method CCM --steps-per-env 5" + out + flag, "seed");
+    expect_error("tma random --env stump-tracks" + flag, "seed");
+  }
+  EXPECT_FALSE(fs::exists(dir / "run"));
+  fs::remove_all(dir);
+}
+
 TEST(HyperparamCli, TrainRefusesARepeatedName) {
   const fs::path dir = cradle::test::fresh_dir("hp_train");
   expect_error("train --config " + cradle::test::self_touch_config(dir, 100) +
