@@ -11,6 +11,7 @@ Splits are "train", "moderate", "extreme" or a YAML file of task sets (see docs/
 """
 
 import numbers
+import os
 
 import numpy as np
 
@@ -19,6 +20,34 @@ from . import spaces
 from .env import _EnvBase
 
 ENV_NAMES = tuple(_cradle.sami_env_names())
+
+
+def _short(value):
+    """A value for a one-line error message."""
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _integer(name, value, low, high):
+    """An int argument in [low, high] or a one-line ValueError naming it (bools refused)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or not (
+            low <= value <= high):
+        raise ValueError(f"{name} must be an integer from {low} to {high} (got {_short(value)})")
+    return int(value)
+
+
+def _seed(seed):
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, numbers.Integral) or not (
+            0 <= seed < 2**64):
+        raise ValueError(f"seed must be a non-negative integer below 2^64, not {_short(seed)}")
+    return int(seed)
+
+
+def _flag(name, value):
+    """A bool argument (True, False, or numpy's) or a one-line ValueError naming it."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False (got {_short(value)})")
+    return bool(value)
 
 
 class SamiEnv(_EnvBase):
@@ -34,47 +63,94 @@ class SamiEnv(_EnvBase):
     """
 
     def __init__(self, name, split="train", seed=0, render_mode=None, contact_forces=False):
-        if render_mode not in (None, "rgb_array"):
-            raise ValueError(f"render_mode must be None or 'rgb_array', not {render_mode!r}")
-        if not isinstance(seed, numbers.Integral) or seed < 0:
-            raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
-        self._core = _cradle.SamiEnv(str(name), str(split), int(seed), bool(contact_forces))
+        if render_mode is not None and render_mode != "rgb_array":
+            raise ValueError(f"render_mode must be None or 'rgb_array', not {_short(render_mode)}")
+        if not isinstance(name, str):
+            raise ValueError(f"name must be one of {', '.join(ENV_NAMES)} (got {_short(name)})")
+        if not isinstance(split, (str, os.PathLike)):
+            raise ValueError("split must be train, moderate, extreme or a path to a .yml file "
+                             f"(got {_short(split)})")
+        split = os.fspath(split)
+        seed = _seed(seed)
+        contact_forces = _flag("contact_forces", contact_forces)
+        self._core = _cradle.SamiEnv(name, split, seed, contact_forces)
         self.name = self._core.name
-        self.split = str(split)
+        self.split = split
         self.render_mode = render_mode
         self.action_space = spaces.from_core_box(self._core.action_space)
+        self._low = np.asarray(self.action_space.low, dtype=np.float64)
+        self._high = np.asarray(self.action_space.high, dtype=np.float64)
         self.observation_space = spaces.from_core_dict(self._core.observation_space)
         self.max_episode_steps = self._core.horizon
         self.dt = self._core.dt
         self.metadata = {"render_modes": ["rgb_array"], "render_fps": round(1.0 / self.dt)}
 
+    def _live(self, method):
+        """The C++ env, or a one-line ValueError once close() released it."""
+        if self._core is None:
+            raise ValueError(f"{method}: the env is closed (make a new one)")
+        return self._core
+
     def reset(self, *, seed=None, options=None):
-        if seed is not None and (not isinstance(seed, numbers.Integral) or seed < 0):
-            raise ValueError(f"seed must be a non-negative integer, not {seed!r}")
-        return self._core.reset(seed)
+        """``seed``: an integer from 0 to 2^64 - 1 or None. SaMI envs take no reset options (the
+        split draws each episode's hidden parameters): ``options`` must be None or empty."""
+        core = self._live("reset")
+        if seed is not None:
+            seed = _seed(seed)
+        if options is not None and (not isinstance(options, dict) or options):
+            keys = ", ".join(map(str, options)) if isinstance(options, dict) else _short(options)
+            raise ValueError(f"reset options {keys} are not supported (SaMI envs take no reset "
+                             "options; the split draws the hidden parameters)")
+        return core.reset(seed)
 
     def step(self, action):
-        return self._core.step(np.asarray(action, dtype=np.float64).reshape(-1))
+        """``action``: action_space.shape real, finite values (anything else is a one-line
+        ValueError), clipped to the action space. The reference's PandaPush clips to [-1, 1] too;
+        its locomotion envs let MuJoCo clamp the controls to their ctrlrange but charge the
+        control cost on the unclipped action, which here is charged on the clipped one."""
+        core = self._live("step")
+        try:
+            array = np.asarray(action)
+        except (TypeError, ValueError):
+            array = np.asarray(None)
+        if array.dtype.kind not in "iuf":
+            raise ValueError(
+                f"action has dtype {array.dtype} (expected real numbers)")
+        if array.shape != self._low.shape:
+            raise ValueError(f"action has shape {array.shape} (expected {self._low.size} values, "
+                             f"shape {self._low.shape})")
+        array = array.astype(np.float64)
+        bad = np.flatnonzero(~np.isfinite(array))
+        if bad.size:
+            raise ValueError(f"action {bad[0]} is {array[bad[0]]} (expected finite values)")
+        return core.step(np.clip(array, self._low, self._high))
 
     @property
     def model(self):
         """Read-only numpy views of the env's MuJoCo model: this episode's hidden parameters
         (body_mass, dof_damping, geom_size, geom_friction, pair_friction, ...), with the sizes
         and body/joint/geom/actuator names."""
-        return self._core.model
+        return self._live("model").model
 
     @property
     def data(self):
         """Read-only numpy views of the env's mjData (qpos, qvel, xpos, ...); they follow the env."""
-        return self._core.data
+        return self._live("data").data
 
     def render(self, width=320, height=240):
+        """An RGB frame (height, width, 3), width and height from 16 to 4096; None unless
+        render_mode is "rgb_array"."""
+        core = self._live("render")
+        width = _integer("width", width, 16, 4096)
+        height = _integer("height", height, 16, 4096)
         if self.render_mode != "rgb_array":
             return None
-        return self._core.render(int(width), int(height))
+        return core.render(width, height)
 
     def close(self):
-        pass
+        """Releases the env (views from model and data stay readable); later calls raise
+        ValueError. Closing twice is fine."""
+        self._core = None
 
     def __repr__(self):
         return f"<SamiEnv {self.name} split={self.split}>"

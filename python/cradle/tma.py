@@ -61,13 +61,68 @@ def _option_text(name, value):
 
 
 def _task_values(name, value):
-    """A task value (number, sequence or numpy array) as a list of floats."""
-    if isinstance(value, (numbers.Real, np.generic)) and np.ndim(value) == 0:
-        return [float(value)]
-    array = np.asarray(value, dtype=np.float64)
-    if array.ndim != 1:
-        raise ValueError(f"task parameter {name} must be a number or a 1-D sequence")
-    return [float(v) for v in array]
+    """A task value (a real number, a 1-D sequence or numpy array of them) as a list of floats;
+    ValueError naming the parameter for anything else (bools, strings, complex, nested)."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):
+        array = None
+    if array is None or array.dtype.kind not in "iuf" or array.ndim > 1:
+        raise ValueError(f"task parameter {name} must be a real number or a 1-D sequence of real "
+                         f"numbers (got {_short(value)})")
+    return [float(v) for v in np.atleast_1d(array.astype(np.float64))]
+
+
+def _short(value):
+    """A value for a one-line error message."""
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _integer(name, value, low, high=None):
+    """An int argument in [low, high] or a one-line ValueError naming it (bools refused)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) or not (
+            low <= value and (high is None or value <= high)):
+        bound = f"from {low} to {high}" if high is not None else f">= {low}"
+        raise ValueError(f"{name} must be an integer {bound} (got {_short(value)})")
+    return int(value)
+
+
+def _flag(name, value):
+    """A bool argument (True, False, or numpy's) or a one-line ValueError naming it."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False (got {_short(value)})")
+    return bool(value)
+
+
+def _number(name, value):
+    """A finite real argument or a one-line ValueError naming it."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not (
+            np.isfinite(float(value))):
+        raise ValueError(f"{name} must be a finite real number (got {_short(value)})")
+    return float(value)
+
+
+def real_action(action, size):
+    """``action`` as a float64 vector of ``size`` finite values, or a one-line ValueError saying
+    which of shape, dtype (real) and finiteness it breaks."""
+    try:
+        array = np.asarray(action)
+    except (TypeError, ValueError):
+        array = np.asarray(None)
+    if array.dtype.kind not in "iuf":
+        raise ValueError(f"action has dtype {array.dtype} (expected real numbers)")
+    if array.shape != (size,):
+        raise ValueError(
+            f"action has shape {array.shape} (expected {size} values, shape ({size},))")
+    array = array.astype(np.float64)
+    bad = np.flatnonzero(~np.isfinite(array))
+    if bad.size:
+        raise ValueError(f"action {bad[0]} is {array[bad[0]]} (expected finite values)")
+    return array
+
+
+_SEED_MAX = 2**64 - 1
 
 
 class TmaEnv:
@@ -98,21 +153,29 @@ class TmaEnv:
             raise ValueError(
                 f"unknown TeachMyAgent option '{unknown[0]}' (expected one of: {accepted})")
         pairs = [(k, _option_text(k, v)) for k, v in options.items() if v is not None]
-        if env_id not in ENV_IDS:
-            raise ValueError(f"unknown env id '{env_id}' (expected one of {', '.join(ENV_IDS)})")
-        if lidars_type is not None and lidars_type not in LIDAR_TYPES:
-            raise ValueError(f"unknown lidars_type '{lidars_type}' (expected down, up or full)")
-        if render_mode not in (None, "rgb_array"):
-            raise ValueError(f"unknown render_mode '{render_mode}' (expected 'rgb_array' or None)")
+        if not isinstance(env_id, str) or env_id not in ENV_IDS:
+            raise ValueError(
+                f"unknown env id {_short(env_id)} (expected one of {', '.join(ENV_IDS)})")
+        if not isinstance(agent_body_type, str):  # the env names the embodiments for other names
+            raise ValueError("agent_body_type must be an embodiment name, one of tma.embodiments() "
+                             f"(got {_short(agent_body_type)})")
+        if lidars_type is not None and (not isinstance(lidars_type, str)
+                                        or lidars_type not in LIDAR_TYPES):
+            raise ValueError(
+                f"unknown lidars_type {_short(lidars_type)} (expected down, up or full)")
+        if render_mode is not None and render_mode != "rgb_array":
+            raise ValueError(
+                f"unknown render_mode {_short(render_mode)} (expected 'rgb_array' or None)")
         self._env = _cradle.TmaEnv(
             env_id,
             agent_body_type,
             lidars_type or "",
-            bool(movable_creepers),
-            float(water_clip),
-            int(max_episode_steps),
+            _flag("movable_creepers", movable_creepers),
+            _number("water_clip", water_clip),
+            _integer("max_episode_steps", max_episode_steps, 1, 2**31 - 1),
             pairs,
         )
+        self._needs_reset = True
         self.env_id = env_id
         self.render_mode = render_mode
         self.agent_body_type = agent_body_type
@@ -122,43 +185,72 @@ class TmaEnv:
             -np.inf, np.inf, (self._env.observation_size,), np.float32
         )
 
+    def _live(self, method):
+        """The C++ env, or a one-line ValueError once close() released it."""
+        if self._env is None:
+            raise ValueError(f"{method}: the env is closed (make a new one)")
+        return self._env
+
     @property
     def body_type(self):
         """walker, climber, swimmer or amphibian."""
-        return self._env.body_type
+        return self._live("body_type").body_type
 
     def set_environment(self, **task):
         """Sets the task of the next reset(). Stump Tracks: stump_height, obstacle_spacing, and
         the optional stump_width=(mean, std), stump_rot=(mean, std) (radians), roughness.
-        Parkour: input_vector (input_CPPN_dim values, 3 by default), water_level, creepers_width, creepers_height,
-        creepers_spacing, terrain_cppn_scale. None leaves a parameter at its default."""
+        Parkour: input_vector (input_CPPN_dim values, 3 by default), water_level,
+        creepers_width, creepers_height, creepers_spacing, terrain_cppn_scale. None leaves a
+        parameter at its default. A value that is not a real number or 1-D sequence of them, an
+        unknown name or a value out of range is a one-line ValueError naming the parameter."""
+        env = self._live("set_environment")
         params = [(k, _task_values(k, v)) for k, v in task.items() if v is not None]
-        self._env.set_environment(params)
+        env.set_environment(params)
 
     def reset(self, *, seed=None, options=None):
-        if options:
+        """``seed``: an integer from 0 to 2^64 - 1 or None. ``options``: a dict of the task
+        parameters set_environment takes (they stay set for later resets); any other key is a
+        ValueError."""
+        env = self._live("reset")
+        if seed is not None:
+            seed = _integer("seed", seed, 0, _SEED_MAX)
+        if options is not None:
+            if not isinstance(options, dict) or not all(isinstance(k, str) for k in options):
+                raise ValueError("reset options must be a dict of task parameters as "
+                                 f"set_environment takes (got {_short(options)})")
             self.set_environment(**options)
-        return self._env.reset(seed), {}
+        obs = env.reset(seed)
+        self._needs_reset = False
+        return obs, {}
 
     def step(self, action):
-        action = np.asarray(action, dtype=np.float64).ravel()
-        obs, reward, terminated, truncated, success = self._env.step(action)
+        """``action``: action_space.shape real, finite values (anything else is a one-line
+        ValueError). As in the reference, which clips the motor commands to [-1, 1], values
+        outside [-1, 1] are clipped."""
+        env = self._live("step")
+        if self._needs_reset:
+            raise ValueError("step: call reset() before the first step")
+        action = real_action(action, env.action_size)
+        obs, reward, terminated, truncated, success = env.step(action)
         return obs, reward, terminated, truncated, {"success": success}
 
     def render(self, width=600, height=400, lidars=True):
-        """An RGB frame of the scene (camera on the head)."""
-        return self._env.render(width, height, lidars)
+        """An RGB frame of the scene (camera on the head); width and height from 16 to 4096."""
+        env = self._live("render")
+        return env.render(_integer("width", width, 16, 4096),
+                          _integer("height", height, 16, 4096), _flag("lidars", lidars))
 
     def terrain(self):
         """(x, ground, ceiling, water_y) of the current terrain (ceiling empty in Stump Tracks)."""
-        xs, ground, ceiling, water_y = self._env.terrain()
+        xs, ground, ceiling, water_y = self._live("terrain").terrain()
         return np.asarray(xs), np.asarray(ground), np.asarray(ceiling), water_y
 
     def head_position(self):
-        return self._env.head_position()
+        return self._live("head_position").head_position()
 
     def close(self):
-        pass
+        """Releases the env; later calls raise ValueError. Closing twice is fine."""
+        self._env = None
 
 
 def make(env_id, **kwargs):
