@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <numbers>
 #include <stdexcept>
@@ -16,12 +17,19 @@ namespace {
 constexpr const char* kStumpId = "parametric-continuous-stump-tracks-v0";
 constexpr const char* kParkourId = "parametric-continuous-parkour-v0";
 
+// A number for an error message: short (std::to_string writes 1e300 with 301 digits, 1e-9 as 0).
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+
 // Checks one task value: finite and within [lo, hi].
 double checked(const std::string& name, double v, double lo, double hi) {
   if (!std::isfinite(v) || v < lo || v > hi) {
-    throw UserError("task parameter " + name + " = " + std::to_string(v) +
-                    " is out of range (expected a finite value in [" + std::to_string(lo) + ", " +
-                    std::to_string(hi) + "])");
+    throw UserError("task parameter " + name + " = " + number_text(v) +
+                    " is out of range (expected a finite value in [" + number_text(lo) + ", " +
+                    number_text(hi) + "])");
   }
   return v;
 }
@@ -266,9 +274,8 @@ void TmaEnv::set_parkour_task(const ParkourTask& task) {
   checked("creepers_spacing", task.creepers_spacing, 0, 10);
   if (!std::isfinite(task.terrain_cppn_scale) || task.terrain_cppn_scale <= 1 ||
       task.terrain_cppn_scale > 100) {
-    throw UserError(
-        "task parameter terrain_cppn_scale = " + std::to_string(task.terrain_cppn_scale) +
-        " is out of range (expected (1, 100])");
+    throw UserError("task parameter terrain_cppn_scale = " + number_text(task.terrain_cppn_scale) +
+                    " is out of range (expected (1, 100])");
   }
   parkour_task_ = task;
 }
