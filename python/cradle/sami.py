@@ -74,6 +74,7 @@ class SamiEnv(_EnvBase):
         seed = _seed(seed)
         contact_forces = _flag("contact_forces", contact_forces)
         self._core = _cradle.SamiEnv(name, split, seed, contact_forces)
+        self._needs_reset = True
         self.name = self._core.name
         self.split = split
         self.render_mode = render_mode
@@ -101,7 +102,9 @@ class SamiEnv(_EnvBase):
             keys = ", ".join(map(str, options)) if isinstance(options, dict) else _short(options)
             raise ValueError(f"reset options {keys} are not supported (SaMI envs take no reset "
                              "options; the split draws the hidden parameters)")
-        return core.reset(seed)
+        result = core.reset(seed)
+        self._needs_reset = False
+        return result
 
     def step(self, action):
         """``action``: action_space.shape real, finite values (anything else is a one-line
@@ -109,6 +112,8 @@ class SamiEnv(_EnvBase):
         its locomotion envs let MuJoCo clamp the controls to their ctrlrange but charge the
         control cost on the unclipped action, which here is charged on the clipped one."""
         core = self._live("step")
+        if self._needs_reset:
+            raise ValueError("step: call reset() before the first step")
         try:
             array = np.asarray(action)
         except (TypeError, ValueError):

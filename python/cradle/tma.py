@@ -277,6 +277,8 @@ class OldGymEnv:
         return obs, reward, terminated or truncated, info
 
     def render(self, mode="rgb_array"):
+        if mode != "rgb_array":
+            raise ValueError(f"render mode {_short(mode)} is not supported (expected 'rgb_array')")
         return self.env.render()
 
     def close(self):

@@ -89,6 +89,8 @@ CASES = [
     ("sami contact_forces str", lambda: sami.make("Hopper", contact_forces="yes"),
      "contact_forces"),
     ("sami render_mode", lambda: sami.make("Hopper", render_mode="human"), "render_mode"),
+    ("sami step before reset", lambda: sami_env(False).step(np.zeros(3)), "reset"),
+    ("tma old gym render human", lambda: tma.gym.make(ST).render(mode="human"), "human"),
     ("sami action nan", lambda: sami_env().step([0, np.nan, 0]), "action 1 is nan"),
     ("sami action inf", lambda: sami_env().step([0, 0, -np.inf]), "finite"),
     ("sami action 2-D", lambda: sami_env().step(np.zeros((1, 3))), "shape"),
