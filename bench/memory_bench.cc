@@ -1,4 +1,4 @@
-// Memory per env and MuJoCo's size high-water marks (issue 19, item 2).
+// Memory per env and MuJoCo's size high-water marks.
 //
 //   build/cradle_bench --benchmark_filter=EnvMemory        resident MB per env, 1 / 2 / 8 envs
 //   build/cradle_bench --benchmark_filter=SizeHighWater    max contacts, constraints, stack use

@@ -1,4 +1,4 @@
-// The synthetic-student comparison of teachers (issue 14): each teacher trains 16 simulated
+// The synthetic-student comparison of teachers: each teacher trains 16 simulated
 // students (teach/synthetic_student.h: a 20 x 20 grid over [0, 1]^2, 60 % unlearnable, skills
 // spreading from one mastered corner) for the same number of episodes, against Random on the same
 // seeds. Counters: % of the space mastered (mean, std) for the teacher and Random, and Welch's t.

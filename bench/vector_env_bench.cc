@@ -135,7 +135,7 @@ void BM_VecEnvScalingSelfTouch(benchmark::State& state) {
 }
 BENCHMARK(BM_VecEnvScalingSelfTouch)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The async target (issue 19 item 3), measured so that the host's drift cancels: each iteration
+// The async vector env's target, measured so that the host's drift cancels: each iteration
 // runs, back to back, three slices of the same work (`kStepsPerEnv` steps of each of N self-touch
 // envs, a separate set of envs for each) on 2 threads:
 // - ceiling: each of 2 threads steps its own N/2 envs round robin with no synchronisation at all;

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The long-running vision soak (issue 19, item 0): hand-regard envs rendering both eyes on a
+# The long-running vision soak: hand-regard envs rendering both eyes on a
 # thread pool while evaluation envs with video renderers are built, run and freed beside them,
 # the pattern that crashed in libOSMesa. Every stage must finish (exit 0).
 #

@@ -29,9 +29,9 @@ std::optional<GlBackend> gl_backend_from_env();
 // The process's one GL lock. Mesa keeps per-process state under every context (OSMesa draws all
 // contexts through one llvmpipe screen, a process singleton) and MuJoCo 2.2.2 reloads its
 // process-wide GL function table in every mjr_makeContext, so two threads inside GL at once, even
-// in different contexts, are the likely cause of the libOSMesa crashes of issue 19 (two envs
-// rendering on two pool threads while contexts are built and freed). All GL work, context creation and
-// destruction included, happens under this lock; GlScope takes it.
+// in different contexts, are the likely cause of the libOSMesa crashes seen in hand-regard
+// training (two envs rendering on two pool threads while contexts are built and freed). All GL
+// work, context creation and destruction included, happens under this lock; GlScope takes it.
 std::mutex& gl_mutex();
 
 // One GL context with a compatibility profile (MuJoCo's fixed-function renderer), owned by this

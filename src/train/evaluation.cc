@@ -145,8 +145,8 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   const fs::path dir = config.save_dir;
   EvaluationReport report;
 
-  // The training scene when there is one (no re-build; scene/ since issue 19, the top level in
-  // older results folders), else the config's.
+  // The training scene when there is one (no re-build; under scene/ in current results folders,
+  // at the top level in older ones), else the config's.
   fs::path scene_file = dir / scene::kSceneDirName / scene::kSceneFileName;
   if (!fs::exists(scene_file)) scene_file = dir / scene::kSceneFileName;
   auto assets =

@@ -1,4 +1,4 @@
-// Adapter from the SaMI family (src/sami/) to today's envs::Env interface, so the learners, the
+// Adapter from the SaMI family (src/sami/) to the envs::Env interface, so the learners, the
 // vector env and the Python Env wrapper can drive SaMI envs. Kept thin on purpose.
 #pragma once
 
