@@ -22,6 +22,11 @@ from .env import _EnvBase
 ENV_NAMES = tuple(_cradle.sami_env_names())
 
 
+def _is_text(value, text):
+    """value == text for a str value (an array would compare element by element)."""
+    return isinstance(value, str) and value == text
+
+
 def _short(value):
     """A value for a one-line error message."""
     text = repr(value).replace("\n", " ")
@@ -63,7 +68,7 @@ class SamiEnv(_EnvBase):
     """
 
     def __init__(self, name, split="train", seed=0, render_mode=None, contact_forces=False):
-        if render_mode is not None and render_mode != "rgb_array":
+        if render_mode is not None and not _is_text(render_mode, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', not {_short(render_mode)}")
         if not isinstance(name, str):
             raise ValueError(f"name must be one of {', '.join(ENV_NAMES)} (got {_short(name)})")

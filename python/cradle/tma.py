@@ -73,6 +73,11 @@ def _task_values(name, value):
     return [float(v) for v in np.atleast_1d(array.astype(np.float64))]
 
 
+def _is_text(value, text):
+    """value == text for a str value (an array would compare element by element)."""
+    return isinstance(value, str) and value == text
+
+
 def _short(value):
     """A value for a one-line error message."""
     text = repr(value).replace("\n", " ")
@@ -163,7 +168,7 @@ class TmaEnv:
                                         or lidars_type not in LIDAR_TYPES):
             raise ValueError(
                 f"unknown lidars_type {_short(lidars_type)} (expected down, up or full)")
-        if render_mode is not None and render_mode != "rgb_array":
+        if render_mode is not None and not _is_text(render_mode, "rgb_array"):
             raise ValueError(
                 f"unknown render_mode {_short(render_mode)} (expected 'rgb_array' or None)")
         self._env = _cradle.TmaEnv(
@@ -277,7 +282,7 @@ class OldGymEnv:
         return obs, reward, terminated or truncated, info
 
     def render(self, mode="rgb_array"):
-        if mode != "rgb_array":
+        if not _is_text(mode, "rgb_array"):
             raise ValueError(f"render mode {_short(mode)} is not supported (expected 'rgb_array')")
         return self.env.render()
 
