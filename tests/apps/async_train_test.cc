@@ -1,4 +1,4 @@
-// `cradle train --async-batch K` end to end (issue 19 item 3): PPO collects through the async
+// `cradle train --async-batch K` end to end: PPO collects through the async
 // vector on a small self-touch config with intrinsic rewards; the training log holds every
 // episode once (as many entries of as many steps as the lock-step run's, since each env fills the
 // same rows of each rollout), checkpoints are episode boundaries, --resume continues, a sample env

@@ -1,5 +1,5 @@
 // `cradle train --env NAME`: a MIMo sample env trained by the one training loop, with a curriculum
-// from a task-space file (issue 14 item 5): progress.csv, checkpoints and the teacher's book,
+// from a task-space file: progress.csv, checkpoints and the teacher's book,
 // continued by --resume; BabyBench-only flags and unknown envs are one-line errors.
 #include <gtest/gtest.h>
 

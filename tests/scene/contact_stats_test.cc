@@ -1,10 +1,10 @@
-// Contact statistics of the compiled reference scenes against the reference's (issue 19, item 1):
+// Contact statistics of the compiled reference scenes against the reference's:
 // mean contacts and constraint rows per step over the first 1,000 zero-action env steps after
 // reset(0), within 5 %. The reference kit is not installed here, so the numbers below come from
 // the reference-equivalent scenes: our composition with the reference's crib mattress (friction
 // 0.1, no contact priority, MuJoCo's default solver parameters: spec babybench_layer.md §2.6),
-// which is the default since issue 19; the body, joints, actuators and options match the kit's to
-// 6 digits (issue 19). Recorded with MuJoCo 2.2.2 by this test's own measure() (docs/
+// which is the default; the body, joints, actuators and options match the kit's to 6 digits.
+// Recorded with MuJoCo 2.2.2 by this test's own measure() (docs/
 // babybench-physics.md). The opt-in low-friction mattress must stay a different task: more of its
 // contacts slide.
 #include <gtest/gtest.h>

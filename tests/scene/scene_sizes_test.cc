@@ -1,4 +1,4 @@
-// MuJoCo sizes of the BabyBench scenes (issue 19, item 2): nconmax, njmax and nstack leave a
+// MuJoCo sizes of the BabyBench scenes: nconmax, njmax and nstack leave a
 // margin over what random actions from random starts use, and an env stays far below 50 MB.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>

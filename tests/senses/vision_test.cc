@@ -204,7 +204,7 @@ TEST(Vision, EyesOnSeveralThreads) {
   check(a);
 }
 
-// What crashed hand-regard training in libOSMesa (issue 19): envs rendering on pool threads while
+// What crashed hand-regard training in libOSMesa: envs rendering on pool threads while
 // another thread builds and frees contexts (the evaluation env, its video renderer). Every image
 // must stay exact and nothing may crash.
 TEST(Vision, ContextsComeAndGoWhileOtherThreadsRender) {

@@ -1,4 +1,4 @@
-// MuJoCo size overflows (issue 19, item 2): a step that runs out of contacts, constraint rows or
+// MuJoCo size overflows: a step that runs out of contacts, constraint rows or
 // stack is counted and ends early instead of silently dropping physics; the next step is normal
 // once the cause is gone. A diverging step is counted and ends early the same way.
 #include <gtest/gtest.h>
