@@ -7,7 +7,7 @@
 #                                           4 envs on 2 threads, an evaluation with video every
 #                                           100,000 steps and at the end of each
 #   STEPS=50000 scripts/soak-vision.sh      a shorter run
-#   TRAIN=1 scripts/soak-vision.sh          also the issue's own run: PPO + hand_visibility,
+#   TRAIN=1 scripts/soak-vision.sh          also the run that crashed: PPO + hand_visibility,
 #                                           300,000 steps on 2 envs, evaluation and random baseline
 #
 # About 1 h per 500,000-step stage on 2 idle cores (≈150-250 env steps/s with vision).
