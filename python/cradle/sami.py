@@ -20,6 +20,8 @@ from . import spaces
 from .env import _EnvBase
 
 ENV_NAMES = tuple(_cradle.sami_env_names())
+# The largest action magnitude step() takes.
+_MAX_ACTION = 1e6
 
 
 def _is_text(value, text):
@@ -112,10 +114,11 @@ class SamiEnv(_EnvBase):
         return result
 
     def step(self, action):
-        """``action``: action_space.shape real, finite values (anything else is a one-line
-        ValueError), clipped to the action space. The reference's PandaPush clips to [-1, 1] too;
-        its locomotion envs let MuJoCo clamp the controls to their ctrlrange but charge the
-        control cost on the unclipped action, which here is charged on the clipped one."""
+        """``action``: action_space.shape real, finite values of magnitude at most 1e6 (anything
+        else is a one-line ValueError). As in the reference, an action outside the action space is
+        passed on as it is: PandaPush clips it to [-1, 1], and the locomotion envs let MuJoCo clamp
+        the controls to their ctrlrange while the control cost is charged on the action given (so
+        a policy that overshoots pays for it, as it did in SaMI's runs)."""
         core = self._live("step")
         if self._needs_reset:
             raise ValueError("step: call reset() before the first step")
@@ -133,7 +136,12 @@ class SamiEnv(_EnvBase):
         bad = np.flatnonzero(~np.isfinite(array))
         if bad.size:
             raise ValueError(f"action {bad[0]} is {array[bad[0]]} (expected finite values)")
-        return core.step(np.clip(array, self._low, self._high))
+        # No policy outputs such values; the reference's control cost would overflow on them.
+        bad = np.flatnonzero(np.abs(array) > _MAX_ACTION)
+        if bad.size:
+            raise ValueError(f"action {bad[0]} is {array[bad[0]]:.6g} (expected a magnitude of "
+                             f"at most {_MAX_ACTION:g})")
+        return core.step(array)
 
     @property
     def model(self):

@@ -101,6 +101,7 @@ CASES = [
     ("sami action complex", lambda: sami_env().step(np.zeros(3) + 1j), "real"),
     ("sami action str", lambda: sami_env().step("abc"), "real"),
     ("sami action object", lambda: sami_env().step([0, None, 0]), "real"),
+    ("sami action 1e300", lambda: sami_env().step([0, 1e300, 0]), "action 1 is 1e+300"),
     ("sami reset options", lambda: sami_env().reset(options={"mass": 2.0}), "mass"),
     ("sami reset options list", lambda: sami_env().reset(options=["mass"]), "options"),
     ("sami reset seed -1", lambda: sami_env().reset(seed=-1), "seed"),
@@ -149,16 +150,15 @@ def test_sami_valid_calls_still_work():
     obs, info = env.reset(seed=5, options={})
     assert set(obs) == set(env.observation_space.spaces)
     env.step([0.1, 0.2, 0.3])
-    # Out-of-range finite actions are clipped to the action space (the reward is the clipped
-    # action's too).
+    # An out-of-range action moves the body as the clamped one (MuJoCo clamps the controls), but
+    # its control cost is the reference's, on the action given: 0.1 * sum(a^2) for Hopper.
     env.reset(seed=5)
-    _, clipped_reward, *_ = env.step(np.ones(3))
-    clipped_qpos = env.data.qpos.copy()
+    _, clamped_reward, *_ = env.step(np.ones(3))
+    clamped_qpos = env.data.qpos.copy()
     env.reset(seed=5)
-    _, reward, *_ = env.step(np.full(3, 1e300))
-    assert reward == clipped_reward
-    np.testing.assert_array_equal(env.data.qpos, clipped_qpos)
-    np.testing.assert_array_equal(env.data.ctrl, env.action_space.high)
+    _, reward, *_ = env.step(np.full(3, 10.0))
+    np.testing.assert_array_equal(env.data.qpos, clamped_qpos)
+    assert reward == pytest.approx(clamped_reward - 0.1 * 3 * (100.0 - 1.0), abs=1e-6)
     env.reset(seed=None, options=None)
     model = env.model
     env.close()
