@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -39,6 +40,7 @@
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
 #include "learn/vector_env.h"
+#include "teach/registry.h"
 #include "tma/render.h"
 
 extern char** environ;
@@ -61,23 +63,115 @@ struct CampaignLine {
 // Arguments the launcher sets itself for every seed.
 const std::set<std::string> kLauncherArgs = {"--seed", "--out", "--resume", "--exp_name"};
 
-// Names become folder names: no separators, spaces or shell characters.
+// Bounds of a campaign: seeds per line, the largest seed offset, runs per campaign file, env
+// steps per run (millions), local jobs.
+constexpr int kMaxSeeds = 100000;
+constexpr int kMaxOffset = 1000000000;
+constexpr long kMaxRuns = 1000000;
+constexpr double kMinSteps = 1e-6, kMaxSteps = 1000;
+constexpr int kMaxJobs = 4096;
+constexpr size_t kMaxNameLength = 200;
+
+// Names become folder names: letters, digits and _ - . + (no separators, spaces or shell
+// characters), starting with a letter or a digit (so never ".", ".." or a hidden or flag-like
+// folder), at most 200 characters.
 bool valid_name(const std::string& s) {
-  if (s.empty()) return false;
+  if (s.empty() || s.size() > kMaxNameLength || !std::isalnum(static_cast<unsigned char>(s[0])))
+    return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
            c == '+';
   });
 }
+const char* const kNameRule =
+    "expected letters, digits, _ - . + starting with a letter or digit, at most 200 characters";
 
-int parse_count(const std::string& text, const std::string& what, int min) {
-  try {
-    size_t used = 0;
-    const int v = std::stoi(text, &used);
-    if (used == text.size() && v >= min) return v;
-  } catch (const std::exception&) {
+// A byte that would end or break a line of a campaign file or a script (newline, NUL, ...).
+bool has_control(const std::string& s) {
+  return std::any_of(s.begin(), s.end(), [](char c) {
+    return std::iscntrl(static_cast<unsigned char>(c)) && c != '\t';
+  });
+}
+
+// A value for error messages: control characters shown as \xNN, and cut after 60 characters.
+std::string shown(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (out.size() >= 60) return out + "...";
+    if (std::iscntrl(static_cast<unsigned char>(c))) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", static_cast<unsigned char>(c));
+      out += buf;
+    } else {
+      out += c;
+    }
   }
-  throw UserError(what + " '" + text + "' (expected an integer >= " + std::to_string(min) + ")");
+  return out;
+}
+
+// A decimal integer in [min, max].
+int parse_count(const std::string& text, const std::string& what, int min, int max) {
+  const bool digits =
+      !text.empty() && text.size() <= 10 && std::all_of(text.begin(), text.end(), [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c));
+      });
+  if (digits) {
+    const long v = std::stol(text);
+    if (v >= min && v <= max) return static_cast<int>(v);
+  }
+  throw UserError(what + " '" + shown(text) + "' (expected an integer from " + std::to_string(min) +
+                  " to " + std::to_string(max) + ")");
+}
+
+// --steps / --nb_env_steps: env steps per run in millions.
+void check_steps(double steps, const std::string& what) {
+  if (!(steps >= kMinSteps && steps <= kMaxSteps)) {
+    std::ostringstream s;
+    s << what << " " << steps << " (expected millions of env steps from " << kMinSteps << " to "
+      << kMaxSteps << ")";
+    throw UserError(s.str());
+  }
+}
+
+// A teacher parameter as `cradle tma run --teacher-param k=v` reads it: JSON when it parses, else
+// a string.
+nlohmann::json param_value(const std::string& v) {
+  return nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
+}
+
+// The teacher, its parameters and its expert knowledge, checked as the run will check them: the
+// registry builds the teacher (on a unit 2-D task space), so an unknown name, an unknown key, a
+// value of the wrong type or range, or an expert-knowledge level the teacher refuses is an error
+// naming `where` now rather than in every seed's log later.
+void check_teacher(const std::string& where, const std::string& teacher,
+                   const std::vector<std::string>& params, const std::string& expert_knowledge) {
+  teach::TeacherSetup setup;
+  setup.name = teacher;
+  setup.mins = {0, 0};
+  setup.maxs = {1, 1};
+  for (const std::string& p : params) {
+    const size_t eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw UserError(where + ": --teacher-param '" + shown(p) + "' (expected key=value)");
+    }
+    const std::string key = p.substr(0, eq);
+    if (setup.params.contains(key)) {
+      throw UserError(where + ": --teacher-param " + shown(key) +
+                      " is given twice (expected each key once)");
+    }
+    setup.params[key] = param_value(p.substr(eq + 1));
+  }
+  // Built once per teacher, parameters and level (a campaign file repeats them on every line).
+  static std::set<std::string> checked;
+  const std::string key = teacher + "\n" + setup.params.dump() + "\n" + expert_knowledge;
+  if (checked.count(key)) return;
+  try {
+    setup.expert_knowledge = teach::parse_expert_knowledge(expert_knowledge);
+    teach::make_teacher(setup);
+    checked.insert(key);
+  } catch (const UserError& e) {
+    throw UserError(where + ": " + e.what());
+  }
 }
 
 std::vector<std::string> split_words(const std::string& text) {
@@ -87,13 +181,21 @@ std::vector<std::string> split_words(const std::string& text) {
   return words;
 }
 
-// One non-comment line -> a configuration; `where` names it in errors.
+// One non-comment line -> a configuration; `where` names it in errors. The run's own arguments are
+// passed as words (never through a shell unquoted); the teacher is checked through the registry.
 CampaignLine parse_line(const std::string& text, const std::string& where) {
+  if (has_control(text)) {
+    throw UserError(where + ": a control character in '" + shown(text) +
+                    "' (expected printable words)");
+  }
   CampaignLine line;
   line.text = text;
   const std::vector<std::string> words = split_words(text);
   std::string suffix;
   bool has_seeds = false;
+  // What the run will read as its teacher (`cradle tma run`'s defaults).
+  std::string teacher = "ALP-GMM", expert_knowledge = "high";
+  std::vector<std::string> teacher_params;
   for (size_t i = 0; i < words.size(); ++i) {
     const std::string& w = words[i];
     const bool has_value = i + 1 < words.size() && words[i + 1].rfind("--", 0) != 0;
@@ -101,44 +203,93 @@ CampaignLine parse_line(const std::string& text, const std::string& where) {
     if (w == "--seeds" || w == "--name" || w == "--campaign" || w == "--experiment") {
       if (!has_value) throw UserError(where + ": " + w + " needs a value");
       const std::string& v = words[++i];
+      if (has_seeds && w == "--seeds") throw UserError(where + ": --seeds is given twice");
       if (w == "--seeds") {
         const size_t plus = v.find('+');
-        line.seeds = parse_count(v.substr(0, plus), where + ": --seeds", 1);
+        line.seeds = parse_count(v.substr(0, plus), where + ": --seeds", 1, kMaxSeeds);
         if (plus != std::string::npos) {
-          line.offset = parse_count(v.substr(plus + 1), where + ": --seeds offset", 0);
+          line.offset = parse_count(v.substr(plus + 1), where + ": --seeds offset", 0, kMaxOffset);
         }
         has_seeds = true;
       } else if (!valid_name(v)) {
-        throw UserError(where + ": " + w + " '" + v + "' (expected letters, digits, _ - . +)");
+        throw UserError(where + ": " + w + " '" + shown(v) + "' (" + kNameRule + ")");
       } else {
         (w == "--name" ? line.name : w == "--campaign" ? line.campaign : line.experiment) = v;
       }
       continue;
     }
     if (w.rfind("--", 0) != 0) {
-      if (line.args.empty()) throw UserError(where + ": '" + w + "' is not a --flag");
+      if (line.args.empty()) throw UserError(where + ": '" + shown(w) + "' is not a --flag");
       line.args.push_back(w);
       continue;
     }
     // A starred argument names the experiment too.
     const bool starred = w.rfind("--*", 0) == 0;
-    const std::string flag = starred ? "--" + w.substr(3) : w;
-    if (flag.size() <= 2) throw UserError(where + ": '" + w + "' is not a --flag");
+    std::string flag = starred ? "--" + w.substr(3) : w;
+    if (flag.size() <= 2 || flag[2] == '-' || flag[2] == '*' || flag[2] == '=') {
+      throw UserError(where + ": '" + shown(w) + "' is not a --flag");
+    }
+    // --key=value: the run reads it as --key value.
+    std::string inline_value;
+    const size_t eq = flag.find('=');
+    if (eq != std::string::npos) {
+      inline_value = flag.substr(eq + 1);
+      flag = flag.substr(0, eq);
+    }
     if (kLauncherArgs.count(flag)) {
       throw UserError(where + ": " + flag + " is set by the launcher for every seed (remove it)");
     }
-    line.args.push_back(flag);
+    const bool valued = has_value || eq != std::string::npos;
+    const std::string value = eq != std::string::npos ? inline_value
+                              : has_value             ? words[i + 1]
+                                                      : "";
+    if (starred && (!valued || value.empty())) {
+      throw UserError(where + ": " + w + " needs a value (--*key value appends _key_value to " +
+                      "the name)");
+    }
+    if ((flag == "--teacher" || flag == "--allow_expert_knowledge" || flag == "--nb_env_steps" ||
+         flag == "--teacher-param") &&
+        !valued) {
+      throw UserError(where + ": " + flag + " needs a value");
+    }
+    if (flag == "--teacher") teacher = value;
+    if (flag == "--allow_expert_knowledge") expert_knowledge = value;
+    if (flag == "--teacher-param") {
+      // A vector option: every word up to the next flag.
+      if (eq != std::string::npos) teacher_params.push_back(value);
+      for (size_t j = i + 1;
+           eq == std::string::npos && j < words.size() && words[j].rfind("--", 0) != 0; ++j) {
+        teacher_params.push_back(words[j]);
+      }
+    }
+    if (flag == "--nb_env_steps") {
+      char* end = nullptr;
+      const double steps = std::strtod(value.c_str(), &end);
+      if (end == value.c_str() || *end != '\0') {
+        throw UserError(where + ": --nb_env_steps '" + shown(value) +
+                        "' (expected millions of env steps, a number)");
+      }
+      check_steps(steps, where + ": --nb_env_steps");
+    }
+    line.args.push_back(eq != std::string::npos && !starred ? w : flag);
     if (starred) {
-      suffix += "_" + flag.substr(2);
-      if (has_value) suffix += "_" + words[i + 1];
+      if (eq != std::string::npos) line.args.push_back(value);
+      suffix += "_" + flag.substr(2) + "_" + value;
     }
   }
   if (!has_seeds) throw UserError(where + ": no --seeds N[+OFFSET]");
   if (line.name.empty()) throw UserError(where + ": no --name EXP");
+  if (static_cast<long>(line.offset) + line.seeds - 1 > kMaxOffset) {
+    throw UserError(where + ": --seeds " + std::to_string(line.seeds) + "+" +
+                    std::to_string(line.offset) + " goes past seed " + std::to_string(kMaxOffset) +
+                    " (expected a smaller offset)");
+  }
   line.name += suffix;
   if (!valid_name(line.name)) {
-    throw UserError(where + ": experiment name '" + line.name + "' is not a folder name");
+    throw UserError(where + ": experiment name '" + shown(line.name) + "' is not a folder name (" +
+                    kNameRule + ")");
   }
+  check_teacher(where, teacher, teacher_params, expert_knowledge);
   if (line.experiment.empty()) line.experiment = line.name;
   if (line.campaign.empty()) line.campaign = line.name;
   return line;
@@ -150,15 +301,22 @@ std::vector<CampaignLine> read_campaign(const fs::path& file) {
   std::vector<CampaignLine> lines;
   std::set<std::string> names;
   std::string text;
+  long runs = 0;
   for (int n = 1; std::getline(in, text); ++n) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();  // a CRLF file
     const size_t hash = text.find('#');
     const std::string body = text.substr(0, hash);
-    if (split_words(body).empty()) continue;
     const std::string where = file.string() + ":" + std::to_string(n);
+    if (split_words(body).empty() && !has_control(body)) continue;
     CampaignLine line = parse_line(body, where);
     line.line_no = n;
     if (!names.insert(line.name).second) {
       throw UserError(where + ": experiment '" + line.name + "' appears twice (names must differ)");
+    }
+    runs += line.seeds;
+    if (runs > kMaxRuns) {
+      throw UserError(where + ": the campaign reaches " + std::to_string(runs) +
+                      " runs (expected at most " + std::to_string(kMaxRuns) + " in one file)");
     }
     lines.push_back(std::move(line));
   }
@@ -171,7 +329,8 @@ std::vector<CampaignLine> read_campaign(const fs::path& file) {
 struct GenerateOptions {
   std::string name, teacher, preset = "paper", out;
   std::vector<std::string> teacher_params;
-  double steps = 0;        // millions; 0: the preset's
+  bool steps_given = false;
+  double steps = 0;        // millions; the preset's unless steps_given
   int seeds = 0;           // 0: the preset's
   int test_episodes = -1;  // 0: the named test sets (paper); N: N default test tasks; -1: preset's
 };
@@ -181,6 +340,7 @@ const std::set<std::string> kNeedExpertKnowledge = {"ADR", "GoalGAN", "Setter-So
 
 std::string number(double v) {
   std::ostringstream s;
+  s.precision(15);
   s << v;
   return s.str();
 }
@@ -191,20 +351,26 @@ std::string generate(const GenerateOptions& o) {
     throw UserError("--preset '" + o.preset + "' (expected paper or mini)");
   }
   if (!valid_name(o.name)) {
-    throw UserError("campaign name '" + o.name + "' (expected letters, digits, _ - . +)");
+    throw UserError("campaign name '" + shown(o.name) + "' (" + kNameRule + ")");
   }
-  if (o.teacher.empty() || o.teacher.find_first_of(" \t") != std::string::npos) {
-    throw UserError("--teacher '" + o.teacher + "' (expected a teacher name, e.g. ALP-GMM)");
+  // Every teacher name is a folder-name word; the registry says which exist.
+  const auto& teachers = teach::teacher_names();
+  if (std::find(teachers.begin(), teachers.end(), o.teacher) == teachers.end()) {
+    std::string valid;
+    for (const std::string& t : teachers) valid += (valid.empty() ? "" : ", ") + t;
+    throw UserError("--teacher '" + shown(o.teacher) + "' (expected one of: " + valid + ")");
   }
+  // A parameter becomes one word of every line: no space, comment or control character.
   for (const std::string& p : o.teacher_params) {
     const size_t eq = p.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == p.size() ||
+    if (eq == std::string::npos || eq == 0 || eq + 1 == p.size() || has_control(p) ||
         p.find_first_of(" \t#") != std::string::npos) {
-      throw UserError("--teacher-param '" + p + "' (expected key=value without spaces)");
+      throw UserError("--teacher-param '" + shown(p) + "' (expected key=value without spaces)");
     }
   }
+  if (o.steps_given) check_steps(o.steps, "--steps");
   const bool paper = o.preset == "paper";
-  const double steps = o.steps > 0 ? o.steps : (paper ? 20.0 : 0.02);
+  const double steps = o.steps_given ? o.steps : (paper ? 20.0 : 0.02);
   const int seeds = o.seeds > 0 ? o.seeds : (paper ? 16 : 2);
   const int test_episodes = o.test_episodes >= 0 ? o.test_episodes : (paper ? 0 : 10);
   // Paper: 40 evaluations (every 500 k steps at 20 M); mini: 2.
@@ -241,6 +407,12 @@ std::string generate(const GenerateOptions& o) {
   std::vector<std::string> levels = {"none", "low", "high"};
   if (is_random) levels = {"none"};
   if (kNeedExpertKnowledge.count(o.teacher)) levels = {"low", "high"};
+  // The parameters as the teacher reads them, at every expert-knowledge level written below.
+  std::set<std::string> used_levels(levels.begin(), levels.end());
+  used_levels.insert("low");  // Parkour
+  for (const std::string& ek : used_levels) {
+    check_teacher("--teacher-param", o.teacher, o.teacher_params, ek);
+  }
   f << "#### Skill-specific comparison: Stump Tracks, criteria 1-5\n";
   for (const std::string& ek : levels) {
     const int n = is_adr ? 2 * seeds : seeds;
@@ -537,11 +709,13 @@ std::string array_indices(const std::vector<int>& blocks) {
 int launch_slurm(const LaunchOptions& o, const std::vector<CampaignLine>& lines,
                  const std::vector<SeedRun>& runs, const std::string& commit) {
   std::vector<std::string> job_ids;
+  // The array tasks of each line, in one pass over the runs (not one per line).
+  std::map<const CampaignLine*, std::set<int>> blocks;
+  for (const SeedRun& r : runs) {
+    blocks[r.line].insert((r.seed - r.line->offset) / o.seeds_per_job);
+  }
   for (const CampaignLine& line : lines) {
-    std::set<int> block_set;
-    for (const SeedRun& r : runs) {
-      if (r.line == &line) block_set.insert((r.seed - line.offset) / o.seeds_per_job);
-    }
+    const std::set<int>& block_set = blocks[&line];
     if (block_set.empty()) continue;
     const fs::path exp_dir = fs::path(o.results) / line.name;
     const std::string indices = array_indices({block_set.begin(), block_set.end()});
@@ -563,6 +737,13 @@ int launch_slurm(const LaunchOptions& o, const std::vector<CampaignLine>& lines,
                       "); is Slurm up? (scripts/slurm-local.sh, or --local)");
     }
     const std::string job = last_line(id).substr(0, last_line(id).find(';'));
+    // The id goes into an squeue command line: digits only.
+    if (job.empty() || !std::all_of(job.begin(), job.end(), [](char c) {
+          return std::isdigit(static_cast<unsigned char>(c));
+        })) {
+      throw UserError("sbatch answered '" + shown(job) + "' for " + script_file.string() +
+                      " (expected a job id)");
+    }
     job_ids.push_back(job);
     std::printf("submitted %s: job %s, array %s\n", line.name.c_str(), job.c_str(),
                 indices.c_str());
@@ -587,11 +768,48 @@ int launch_slurm(const LaunchOptions& o, const std::vector<CampaignLine>& lines,
   return 0;
 }
 
-int launch(const LaunchOptions& o) {
-  if (o.jobs < 1) throw UserError("--jobs must be >= 1");
+// Options that reach a script or a command line: nothing that would end a line there. Checked
+// before anything is written.
+void check_launch_options(const LaunchOptions& o, bool slurm) {
+  if (o.jobs < 1 || o.jobs > kMaxJobs) {
+    throw UserError("--jobs " + std::to_string(o.jobs) + " (expected 1 to " +
+                    std::to_string(kMaxJobs) + ")");
+  }
   if (o.local && o.slurm) throw UserError("--local and --slurm exclude each other");
-  const std::vector<CampaignLine> lines = read_campaign(o.file);
+  if (o.results.empty() || has_control(o.results)) {
+    throw UserError("--results '" + shown(o.results) +
+                    "' (expected a folder name without control characters)");
+  }
+  if (has_control(o.runner)) {
+    throw UserError("--runner '" + shown(o.runner) +
+                    "' (expected a command without control characters)");
+  }
+  if (!o.runner.empty() && split_words(o.runner).empty()) {
+    throw UserError("--runner is empty (expected a command)");
+  }
+  for (const std::string& a : o.sbatch_args) {
+    // One `#SBATCH` line each: sbatch reads the option itself, no shell, so one option word.
+    if (a.size() < 2 || a[0] != '-' || has_control(a) ||
+        a.find_first_of(" \t\"'\\") != std::string::npos) {
+      throw UserError("--sbatch '" + shown(a) +
+                      "' (expected one sbatch option without spaces, quotes or control "
+                      "characters, e.g. --time=20:00:00)");
+    }
+  }
+  if (slurm) {
+    // The #SBATCH --output line holds the results folder: one word for sbatch.
+    const std::string abs = fs::absolute(o.results).string();
+    if (abs.find_first_of(" \t\"'\\") != std::string::npos) {
+      throw UserError("--results '" + shown(abs) +
+                      "' (expected a folder without spaces or quotes for sbatch's --output)");
+    }
+  }
+}
+
+int launch(const LaunchOptions& o) {
   const bool slurm = o.slurm || (!o.local && on_path("sbatch"));
+  check_launch_options(o, slurm);
+  const std::vector<CampaignLine> lines = read_campaign(o.file);
   if (o.slurm && !o.dry_run && !on_path("sbatch")) {
     throw UserError("--slurm: sbatch is not on the PATH (start scripts/slurm-local.sh or drop it)");
   }
@@ -775,13 +993,13 @@ void register_tma_campaign(CLI::App& tma) {
   gen->add_option("--test-episodes", go->test_episodes,
                   "0: the reference's test sets (paper); N: N default test tasks (mini 10)")
       ->check(CLI::Range(0, 100000));
-  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.02)")
-      ->check(CLI::PositiveNumber);
+  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.02)");
   gen->add_option("--seeds", go->seeds, "Seeds per configuration (paper 16, mini 2)")
       ->check(CLI::Range(1, 100000));
   gen->add_option("--preset", go->preset, "paper | mini");
   gen->add_option("--out", go->out, "Write here (default: stdout)");
-  gen->callback([go] {
+  gen->callback([go, gen] {
+    go->steps_given = gen->count("--steps") > 0;
     const std::string text = generate(*go);
     if (go->out.empty()) {
       std::fputs(text.c_str(), stdout);

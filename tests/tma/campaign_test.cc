@@ -185,6 +185,109 @@ TEST(TmaCampaign, BadInputIsOneLineError) {
   fs::remove_all(dir);
 }
 
+// Input that would be code in a campaign file or an sbatch script (fuzzing's finds): each is exit
+// 1 with one line naming what is wrong and what was expected, and nothing is written.
+TEST(TmaCampaign, UnsafeOrImplausibleInputIsRefusedAndWritesNothing) {
+  const fs::path dir = fresh("unsafe");
+  const fs::path out = dir / "out.txt";
+  const fs::path results = dir / "res";
+  int files = 0;
+  const auto write = [&](const std::string& text) {
+    const fs::path file = dir / ("c" + std::to_string(files++) + ".txt");
+    std::ofstream(file) << text;
+    return file.string();
+  };
+  const std::string gen = "tma campaign generate x --out " + out.string() + " ";
+  const std::string ok = " --env stump-tracks --teacher Random --allow_expert_knowledge none\n";
+  // A dry run of `text` (local unless `options` say otherwise) into `results`.
+  const auto launch = [&](const std::string& text, const std::string& options = "--local",
+                          const std::string& into = "") {
+    return "tma campaign launch " + write(text) + " --dry-run --results " +
+           (into.empty() ? results.string() : into) + " " + options;
+  };
+  struct Case {
+    std::string args, says;  // the command and a piece of its error
+  };
+  const std::vector<Case> cases = {
+      // generate: teachers through the registry, their parameters as the teacher reads them.
+      {gen + "--teacher 'ALP-GMM;touch${IFS}X'", "expected one of: Random, ADR, ALP-GMM"},
+      {gen + "--teacher NoSuchTeacher", "--teacher 'NoSuchTeacher' (expected one of"},
+      {gen + "--teacher ALP-GMM --teacher-param fit_rate=abc", "'fit_rate' is \"abc\""},
+      {gen + "--teacher ALP-GMM --teacher-param fit_rate=-3", "fit_rate must be >= 2"},
+      {gen + "--teacher ALP-GMM --teacher-param no_such=1", "unknown parameter 'no_such'"},
+      {gen + "--teacher ALP-GMM --teacher-param fit_rate=2 --teacher-param fit_rate=3",
+       "given twice"},
+      {gen + "--teacher ALP-GMM --teacher-param $'fit_rate=150\\ntouch X'", "key=value"},
+      {"tma campaign generate . --teacher Random --out " + out.string(), "campaign name '.'"},
+      {"tma campaign generate .. --teacher Random --out " + out.string(), "campaign name '..'"},
+      {gen + "--teacher Random --steps nan", "--steps nan (expected millions"},
+      {gen + "--teacher Random --steps 1e300", "--steps 1e+300 (expected millions"},
+      {gen + "--teacher Random --steps -1", "--steps -1 (expected millions"},
+      // launch: the file as edited by hand.
+      {launch("--seeds 1 --name a --env stump-tracks --teacher ALP-GMM;touch${IFS}X\n"),
+       ":1: unknown teacher"},
+      {launch("--seeds 1 --name a --teacher NoSuchTeacher\n"), "unknown teacher 'NoSuchTeacher'"},
+      {launch("--seeds 1 --name a --teacher ALP-GMM --teacher-param fit_rate=abc\n"),
+       ":1: ALP-GMM: parameter 'fit_rate'"},
+      {launch("--seeds 1 --name a --teacher=ALP-GMM --teacher-param=fit_rate=abc\n"),
+       "parameter 'fit_rate'"},
+      {launch("--seeds 1 --name a --teacher ADR --allow_expert_knowledge none\n"),
+       "expert knowledge none"},
+      {launch("--seeds 1 --name ." + ok), "--name '.'"},
+      {launch("--seeds 1 --name .." + ok), "--name '..'"},
+      {launch("--seeds 1 --name -a" + ok), "--name"},
+      {launch("# ok\n--seeds 1 --name a" + ok + "--seeds 1 --name b --env stump-tracks --*env\n"),
+       ":3: --*env needs a value"},
+      {launch("--seeds 2000000000 --name a" + ok), ":1: --seeds '2000000000'"},
+      {launch("--seeds 99999999999999999999 --name a" + ok), "--seeds"},
+      {launch("--seeds 2+2000000000 --name a" + ok), "--seeds offset"},
+      {launch("--seeds 1 --name a --nb_env_steps nan" + ok), "--nb_env_steps nan"},
+      {launch("--seeds 1 --name a --nb_env_steps 1e300" + ok), "--nb_env_steps 1e+300"},
+      {launch(std::string("--seeds 1 --name a\x01") + "b" + ok), "control character"},
+      {launch("--seeds 1 --name a" + ok, "--local --jobs 100000"), "--jobs 100000"},
+      // Options that reach the sbatch script or a command line.
+      {launch("--seeds 1 --name a" + ok, "--slurm --sbatch $'--time=1:00:00\\ntouch X'"),
+       "--sbatch '--time=1:00:00\\x0atouch X'"},
+      {launch("--seeds 1 --name a" + ok, "--slurm --sbatch 'x; touch X'"), "--sbatch"},
+      {launch("--seeds 1 --name a" + ok, "--slurm", "$'r\\nx'"), "--results 'r\\x0ax'"},
+      {launch("--seeds 1 --name a" + ok, "--local --runner $'python3\\ntouch X'"), "--runner"},
+  };
+  for (const Case& c : cases) {
+    // bash, for the $'...' words.
+    const RunResult r = cradle::test::run("cd " + dir.string() + " && bash -c " + [&] {
+      std::string q = "'";
+      for (const char ch : std::string(CRADLE_BINARY) + " " + c.args + " 2>&1")
+        q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+      return q + "'";
+    }());
+    EXPECT_EQ(r.status, 1) << c.args << "\n" << r.out;
+    EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << c.args << "\n" << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << c.args << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+    EXPECT_FALSE(fs::exists(results)) << c.args;
+    EXPECT_FALSE(fs::exists(dir / "X")) << c.args;
+  }
+  // The limits themselves are fine; a valid --teacher-param still passes.
+  RunResult r = run_cradle(launch("--seeds 100000+999900001 --name a" + ok, "--slurm"));
+  EXPECT_EQ(r.status, 0) << r.out.substr(0, 300);
+  r = run_cradle(gen + "--teacher ALP-GMM --teacher-param fit_rate=150 " +
+                 "--teacher-param potential_ks=[2,4] --steps 0.5");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(out));
+  r = run_cradle("tma campaign launch " + out.string() + " --slurm --dry-run --results " +
+                 results.string() + " --sbatch --time=20:00:00");
+  ASSERT_EQ(r.status, 0) << r.out.substr(0, 300);
+  EXPECT_NE(r.out.find("--teacher-param 'potential_ks=[2,4]'"), std::string::npos);
+  EXPECT_FALSE(fs::exists(results));
+  // A hand-edited line with shell characters in a run argument is quoted in the script.
+  r = run_cradle(launch("--seeds 1 --name a --env stump;touch${IFS}X" + ok,
+                        "--slurm --sbatch --time=1:00:00"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("--env 'stump;touch${IFS}X'"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
 TEST(TmaCampaign, LocalPoolRunsEverySeedResumesAndAnalyses) {
   const fs::path dir = fresh("local");
   const fs::path file = mini_campaign(dir);
