@@ -203,7 +203,12 @@ CampaignLine parse_line(const std::string& text, const std::string& where) {
     if (w == "--seeds" || w == "--name" || w == "--campaign" || w == "--experiment") {
       if (!has_value) throw UserError(where + ": " + w + " needs a value");
       const std::string& v = words[++i];
-      if (has_seeds && w == "--seeds") throw UserError(where + ": --seeds is given twice");
+      std::string& label = w == "--name"       ? line.name
+                           : w == "--campaign" ? line.campaign
+                                               : line.experiment;
+      if ((w == "--seeds" && has_seeds) || (w != "--seeds" && !label.empty())) {
+        throw UserError(where + ": " + w + " is given twice (expected it once per line)");
+      }
       if (w == "--seeds") {
         const size_t plus = v.find('+');
         line.seeds = parse_count(v.substr(0, plus), where + ": --seeds", 1, kMaxSeeds);
@@ -214,7 +219,7 @@ CampaignLine parse_line(const std::string& text, const std::string& where) {
       } else if (!valid_name(v)) {
         throw UserError(where + ": " + w + " '" + shown(v) + "' (" + kNameRule + ")");
       } else {
-        (w == "--name" ? line.name : w == "--campaign" ? line.campaign : line.experiment) = v;
+        label = v;
       }
       continue;
     }

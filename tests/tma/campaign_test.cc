@@ -236,6 +236,7 @@ TEST(TmaCampaign, UnsafeOrImplausibleInputIsRefusedAndWritesNothing) {
       {launch("--seeds 1 --name ." + ok), "--name '.'"},
       {launch("--seeds 1 --name .." + ok), "--name '..'"},
       {launch("--seeds 1 --name -a" + ok), "--name"},
+      {launch("--seeds 1 --name a --name .." + ok), "--name is given twice"},
       {launch("# ok\n--seeds 1 --name a" + ok + "--seeds 1 --name b --env stump-tracks --*env\n"),
        ":3: --*env needs a value"},
       {launch("--seeds 2000000000 --name a" + ok), ":1: --seeds '2000000000'"},
