@@ -245,6 +245,7 @@ TEST(TmaCampaign, UnsafeOrImplausibleInputIsRefusedAndWritesNothing) {
       {launch("--seeds 1 --name a --nb_env_steps nan" + ok), "--nb_env_steps nan"},
       {launch("--seeds 1 --name a --nb_env_steps 1e300" + ok), "--nb_env_steps 1e+300"},
       {launch(std::string("--seeds 1 --name a\x01") + "b" + ok), "control character"},
+      {launch(std::string("--seeds 1 --name a --env x\0;touch X", 35) + ok), "x\\x00;touch X"},
       {launch("--seeds 1 --name a" + ok, "--local --jobs 100000"), "--jobs 100000"},
       // Options that reach the sbatch script or a command line.
       {launch("--seeds 1 --name a" + ok, "--slurm --sbatch $'--time=1:00:00\\ntouch X'"),
