@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 
@@ -22,5 +23,17 @@ inline const CLI::Validator kSeed(
       return "";
     },
     "SEED");
+
+// A finite number: CLI::Range compares with < and >, so NaN passes it; put this check before it.
+inline const CLI::Validator kFinite(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) {
+        return "expected a finite number, got '" + text + "'";
+      }
+      return "";
+    },
+    "NUMBER");
 
 }  // namespace cradle::apps

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/interrupt.h"
 #include "core/error.h"
@@ -197,6 +198,7 @@ void register_launch(CLI::App& app) {
   cmd->add_option("--master-addr", opts->addr, "Rank 0's address");
   cmd->add_option("--grace", opts->grace,
                   "Seconds the other ranks get to stop after one fails before they are killed")
+      ->check(kFinite)
       ->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("command", opts->command, "The command after --, e.g. cradle train ...");
   cmd->callback([opts] {

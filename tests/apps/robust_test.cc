@@ -61,7 +61,9 @@ TEST(Robust, FlagParseErrorsAreOneLineExitOne) {
         train + " --seed abc", train + " --envs 0", train + " --steps abc", train + " --no-such",
         train + " --algo nope", std::string("no-such-command"), std::string(""),
         std::string("illustrate --envs 100000 --env reach"),
-        "evaluate --config " + quick_config(dir) + " --seed -5"}) {
+        "evaluate --config " + quick_config(dir) + " --seed -5",
+        std::string("launch --nproc 1 --grace nan -- true"),
+        std::string("launch --nproc 1 --grace inf -- true")}) {
     expect_one_line_error(args);
   }
   EXPECT_EQ(cradle("--version").status, 0);
