@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/bench_report.h"
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/config.h"
@@ -135,23 +136,15 @@ void print_bench(const std::string& label, const BenchResult& r, bool json) {
       {"vision", p.vision * 1e6},         {"proprioception", p.proprio * 1e6},
       {"vestibular", p.vestibular * 1e6}, {"other", p.other * 1e6}};
   if (json) {
-    const nlohmann::ordered_json out = {{"config", label},
-                                        {"steps", r.steps},
-                                        {"frame_skip", r.frame_skip},
-                                        {"env_steps_per_s", r.env_steps_per_s},
-                                        {"bare_steps_per_s", r.bare_steps_per_s},
-                                        {"ratio", ratio.median},
-                                        {"ratio_min", ratio.min},
-                                        {"ratio_q1", ratio.q1},
-                                        {"ratio_q3", ratio.q3},
-                                        {"ratio_max", ratio.max},
-                                        {"blocks", ratio.count},
-                                        {"block_steps", r.timing.block_steps},
-                                        {"env_us_per_step", r.env_us},
-                                        {"bare_us_per_step", r.bare_us},
-                                        {"replay_exact", r.timing.replay_exact},
-                                        {"realtime_factor", r.realtime_factor},
-                                        {"modules_us", modules}};
+    nlohmann::ordered_json out = {{"config", label},
+                                  {"steps", r.steps},
+                                  {"frame_skip", r.frame_skip},
+                                  {"env_steps_per_s", r.env_steps_per_s},
+                                  {"bare_steps_per_s", r.bare_steps_per_s},
+                                  {"ratio", ratio.median}};
+    add_block_timing(out, r.timing, r.env_us, r.bare_us);
+    out["realtime_factor"] = r.realtime_factor;
+    out["modules_us"] = modules;
     std::printf("%s\n", out.dump(2).c_str());
     return;
   }

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/bench_report.h"
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/interrupt.h"
@@ -311,16 +312,8 @@ void register_sami(CLI::App& app) {
                        {"steps", t.timing.steps},
                        {"env_steps_per_s", t.env_steps_per_s},
                        {"bare_steps_per_s", t.bare_steps_per_s},
-                       {"ratio", t.ratio},
-                       {"ratio_min", s.min},
-                       {"ratio_q1", s.q1},
-                       {"ratio_q3", s.q3},
-                       {"ratio_max", s.max},
-                       {"blocks", s.count},
-                       {"block_steps", t.timing.block_steps},
-                       {"env_us_per_step", t.env_us},
-                       {"bare_us_per_step", t.bare_us},
-                       {"replay_exact", t.timing.replay_exact}});
+                       {"ratio", t.ratio}});
+        add_block_timing(out.back(), t.timing, t.env_us, t.bare_us);
         continue;
       }
       std::printf("%-20s %12.0f %12.0f %7.3f %6.3f-%6.3f %9.1f %9.1f  %s\n", name.c_str(),

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/bench_report.h"
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/interrupt.h"
@@ -314,17 +315,9 @@ void register_tma(CLI::App& app) {
                        {"steps", bo->steps},
                        {"env_steps_per_s", r.env_steps_per_s},
                        {"bare_steps_per_s", r.bare_steps_per_s},
-                       {"ratio", r.ratio},
-                       {"ratio_min", ratio.min},
-                       {"ratio_q1", ratio.q1},
-                       {"ratio_q3", ratio.q3},
-                       {"ratio_max", ratio.max},
-                       {"blocks", ratio.count},
-                       {"block_steps", r.timing.block_steps},
-                       {"env_us_per_step", r.env_us},
-                       {"bare_us_per_step", r.bare_us},
-                       {"replay_exact", r.timing.replay_exact},
-                       {"reset_ms", r.reset_ms}});
+                       {"ratio", r.ratio}});
+        add_block_timing(out.back(), r.timing, r.env_us, r.bare_us);
+        out.back()["reset_ms"] = r.reset_ms;
       } else {
         std::printf(
             "%-34s env %8.0f steps/s  bare %8.0f Step/s  ratio %.2f (%.2f-%.2f)  reset %.2f ms  "
