@@ -9,49 +9,49 @@
 
 namespace cradle::envs {
 
-ObservationBuffers::ObservationBuffers(const DictSpace& space) {
-  const size_t total = bytes_needed(space);
+namespace {
+// An entry's bytes rounded up to whole max_align_t: every entry starts on such a boundary, so
+// typed views are always aligned.
+size_t padded(size_t bytes) {
+  return (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
+         sizeof(std::max_align_t);
+}
+
+// The entries' offsets and sizes (bytes) and dtypes in one block of bytes_needed(space).
+void lay_out(const DictSpace& space, std::vector<size_t>& offsets, std::vector<size_t>& sizes,
+             std::vector<DType>& dtypes) {
   size_t offset = 0;
   for (const auto& [key, box] : space.entries) {
-    // Every entry starts on a max_align_t boundary, so typed views are always aligned.
-    offsets_.push_back(offset);
     const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
-    sizes_.push_back(bytes);
-    dtypes_.push_back(box.dtype);
-    offset += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
-              sizeof(std::max_align_t);
+    offsets.push_back(offset);
+    sizes.push_back(bytes);
+    dtypes.push_back(box.dtype);
+    offset += padded(bytes);
   }
-  storage_.resize(total / sizeof(std::max_align_t));
+}
+}  // namespace
+
+ObservationBuffers::ObservationBuffers(const DictSpace& space) {
+  lay_out(space, offsets_, sizes_, dtypes_);
+  storage_.resize(bytes_needed(space) / sizeof(std::max_align_t));
   // Value-initialising max_align_t zeroes its members, not its padding (the bytes after the
   // long double's 10): zero every byte so an entry nobody wrote reads 0, not stale heap.
   std::memset(storage_.data(), 0, storage_.size() * sizeof(std::max_align_t));
 }
 
-ObservationBuffers::ObservationBuffers(const DictSpace& space, std::span<std::byte> storage)
-    : ObservationBuffers(DictSpace{}) {
+ObservationBuffers::ObservationBuffers(const DictSpace& space, std::span<std::byte> storage) {
   if (storage.size() < bytes_needed(space) ||
       reinterpret_cast<std::uintptr_t>(storage.data()) % alignof(std::max_align_t) != 0) {
     throw std::invalid_argument("ObservationBuffers: storage too small or misaligned");
   }
-  size_t offset = 0;
-  for (const auto& [key, box] : space.entries) {
-    offsets_.push_back(offset);
-    const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
-    sizes_.push_back(bytes);
-    dtypes_.push_back(box.dtype);
-    offset += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
-              sizeof(std::max_align_t);
-  }
-  storage_.clear();
+  lay_out(space, offsets_, sizes_, dtypes_);
   external_ = storage.data();
 }
 
 size_t ObservationBuffers::bytes_needed(const DictSpace& space) {
   size_t total = 0;
   for (const auto& [key, box] : space.entries) {
-    const size_t bytes = static_cast<size_t>(box.size()) * dtype_size(box.dtype);
-    total += (bytes + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t) *
-             sizeof(std::max_align_t);
+    total += padded(static_cast<size_t>(box.size()) * dtype_size(box.dtype));
   }
   return total + sizeof(std::max_align_t);
 }
