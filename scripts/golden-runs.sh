@@ -1,6 +1,7 @@
 #!/bin/bash
 # Golden runs: seeded short PPO and A2C runs (cradle train on self-touch, cradle illustrate on
-# reach) and seeded evaluations with videos (self-touch, hand regard). Prints a sha256 prefix of
+# reach), seeded evaluations with videos (self-touch, hand regard), a TeachMyAgent student run (SAC
+# with ALP-GMM) and SaMI runs (TESAC and SaCCM, then SaCCM's evaluation on a split). Prints a sha256 prefix of
 # every output (checkpoints, progress.csv, logs, evaluation.json, plots, trajectories, videos),
 # timing columns and keys left out. The same lines before and after a refactor = behaviour
 # unchanged. Usage: scripts/golden-runs.sh CRADLE OUT_DIR
@@ -36,13 +37,27 @@ cp -r "$out/ppo" "$out/eval_touch"
   --seed 3 --policy "$out/eval_touch/checkpoints/final.ckpt" >"$out/eval_touch.log" 2>&1
 "$cradle" evaluate --config "$(dirname "$config")/config_handregard.yml" \
   --save-dir "$out/eval_regard" --episodes 2 --duration 40 --seed 3 >"$out/eval_regard.log" 2>&1
+# A TeachMyAgent student run (SAC + ALP-GMM) and SaMI runs, tiny budgets.
+"$cradle" tma run --env stump-tracks --embodiment old_classic_bipedal --student sac \
+  --teacher ALP-GMM --nb_env_steps 0.004 --test_every 2000 --nb_test_episodes 3 --seed 3 \
+  --hp learning_starts=1000 --hp batch_size=64 --out "$out/tma_sac" --no-progress \
+  >"$out/tma_sac.log" 2>&1
+for method in TESAC SaCCM; do
+  "$cradle" sami train --env CrippleHalfCheetah --method $method --seed 3 --steps-per-env 2200 \
+    --hp learning_starts=1000 --hp train_freq=200 --hp gradient_steps=2 --hp batch_size=4 \
+    --hp contrast_batch_size=4 --hp net_arch=64,64 --out "$out/sami_$method" --no-progress \
+    >"$out/sami_$method.log" 2>&1
+done
+"$cradle" sami evaluate --run "$out/sami_SaCCM" --split moderate --episodes 1 --seed 5 \
+  >"$out/sami_eval.log" 2>&1
 # Hash a run's outputs with what measures time (time/SPS/seconds columns and keys) left out
 # and the output folder's path replaced, so that two folders compare.
 digest() {
-  python3 - "$1" "$2" <<'PY'
+  python3 - "$1" "$2" "${3:-}" <<'PY'
 import csv, hashlib, json, re, sys
-path, root = sys.argv[1], sys.argv[2]
-timing = re.compile(r"time|sps|seconds", re.I)
+path, root, extra = sys.argv[1], sys.argv[2], sys.argv[3]
+# extra: more keys and columns to leave out (the student runs' wall_s, commit, file sizes).
+timing = re.compile(r"time|sps|seconds" + ("|" + extra if extra else ""), re.I)
 def scrub(value):
     if isinstance(value, dict):
         return {k: scrub(v) for k, v in value.items() if not timing.search(k)}
@@ -81,4 +96,10 @@ for name in illustrate_ppo illustrate_a2c; do
   dir=$out/$name
   for file in "$dir"/*; do echo "$name ${file#"$dir"/} $(digest "$file" "$dir")"; done
   grep -h 'test episodes' "$out/$name.log" | sed "s/^/$name /"
+done
+for name in tma_sac sami_TESAC sami_SaCCM; do
+  dir=$out/$name
+  for file in $(cd "$dir" && find . -type f ! -name summary.json | sort); do
+    echo "$name ${file#./} $(digest "$dir/$file" "$dir" '_s$|^commit$|^cradle_version$|^sizes$')"
+  done
 done
