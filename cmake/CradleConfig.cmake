@@ -1,7 +1,7 @@
 # find_package(Cradle) after `make install`: Cradle's static libraries as imported targets.
-#   Cradle::cradle_lib        every room of the MIMo/BabyBench stack (core ... train)
-#   Cradle::cradle_tma_env    TeachMyAgent (Box2D) and its Env adapter
-#   Cradle::cradle_sami_env   the SaMI envs; Cradle::cradle_sami_train their learners
+#   Cradle::cradle_lib        every room (core ... train: every env family, learner and run)
+#   Cradle::cradle_<room>     one room and the rooms below it (e.g. cradle_envs: every env family
+#                             behind the Env interface, without LibTorch)
 # Headers are included as in the source tree ("core/config.h", "envs/env.h"). The libraries link
 # against the same Debian packages as the build, found here again.
 include(CMakeFindDependencyMacro)
