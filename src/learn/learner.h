@@ -37,7 +37,9 @@ struct TrainStats {
   // Losses and diagnostics of the last update(s), by name: "policy_loss", "value_loss",
   // "entropy", "approx_kl", "clip_fraction", "explained_variance", "learning_rate", "std", ...
   // for PPO and A2C; "qf_loss", "qf1_loss", "qf1_values", "actor_loss", "alpha", "alpha_loss"
-  // (CleanRL's names), means over the updates since the last report, for SAC, TD3 and DDPG.
+  // (CleanRL's names), means over the updates since the last report, for SAC, TD3 and DDPG;
+  // "qf_loss", "actor_loss", "alpha", "alpha_loss", "entropy", "sance_loss", "sance_weight" for
+  // SaMI's context learners (learn/meta/sami_learner.h).
   std::map<std::string, double> losses;
 };
 
@@ -61,7 +63,8 @@ struct LearnerOptions {
   // (ObservationConfig: normalize_observations, clip_observations, pool_touch) and the network
   // settings (PolicyConfig for PPO and A2C: pi_layers, vf_layers, activation, cnn_features,
   // ortho_init, log_std_init; OffPolicyNetworkConfig for SAC, TD3 and DDPG: pi_layers,
-  // qf_layers, activation, cnn_features).
+  // qf_layers, activation, cnn_features). SaMI's context learners take theirs only (SamiConfig
+  // and SamiLearnerConfig, learn/meta/sami_learner.h).
   std::map<std::string, std::string> hyperparameters;
   RewardHook reward_hook;      // optional
   std::string device = "cpu";  // only "cpu" for now
@@ -79,7 +82,8 @@ struct LearnerOptions {
 class Learner {
  public:
   virtual ~Learner() = default;
-  virtual std::string_view algorithm() const = 0;  // "ppo", "a2c", "sac", "td3", "ddpg"
+  // "ppo", "a2c", "sac", "td3", "ddpg", ... (learn/registry.h algorithm_names()).
+  virtual std::string_view algorithm() const = 0;
   // Trains until steps() >= total_steps (whole rollouts, so it may overshoot by less than one
   // rollout; off-policy learners: whole vector steps), reporting after each update (off-policy
   // learners: every report_every vector steps and at the end); stops early when on_progress
@@ -101,6 +105,10 @@ class Learner {
   // update the observation statistics.
   virtual void act(const envs::ObservationBuffers& observation, std::span<double> action,
                    bool deterministic) = 0;
+  // Tells act() that its next observation starts a new episode. A learner whose actions depend
+  // on the episode so far (SaMI's context learners, learn/meta/sami_learner.h) restarts that
+  // memory; the others have none and ignore it.
+  virtual void new_episode() {}
   // The expected discounted return from one observation (curriculum teachers' estimate, SPDL):
   // PPO's value head, SAC's min_i Q_i(s, tanh(mean(s))), TD3's and DDPG's min_i Q_i(s, mu(s));
   // NaN for a learner without one. Does not update the observation statistics.

@@ -3,14 +3,21 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "learn/learner.h"
 
 namespace cradle::learn {
 
-// Builds a learner by name ("ppo", "a2c", "sac", "td3", "ddpg"). Throws UserError for an unknown
-// algorithm or hyperparameter, a bad value, or an env the learner cannot handle.
+// Every algorithm make_learner builds, in the order to list them: "ppo", "a2c", "sac", "td3",
+// "ddpg", then SaMI's context learners "tesac", "ccm", "satesac", "saccm", "saccm_all"
+// (learn/meta/sami_learner.h).
+const std::vector<std::string>& algorithm_names();
+
+// Builds a learner by name (one of algorithm_names()). Throws UserError for an unknown algorithm
+// or hyperparameter, a bad value, or an env the learner cannot handle.
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options);
 

@@ -272,51 +272,73 @@ std::pair<torch::Tensor, torch::Tensor> ContextSac::act(const torch::Tensor& obs
 
 void ContextSac::save(const std::filesystem::path& file, long steps) const {
   const CheckpointInfo header{.algorithm = "sami_" + method_, .config = text_, .steps = steps};
-  write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) {
-    write_module(archive, "actor", *actor_);
-    write_module(archive, "critic", *critic_);
-    write_module(archive, "critic_target", *critic_target_);
-    write_module(archive, "encoder", *encoders_.online);
-    write_module(archive, "encoder_target", *encoders_.target);
-    write_module(archive, "bilinear", *encoders_.bilinear);
-    write_optimizer(archive, "actor_optimizer", actor_optimizer_);
-    write_optimizer(archive, "critic_optimizer", critic_optimizer_);
-    write_optimizer(archive, "alpha_optimizer", alpha_optimizer_);
-    write_optimizer(archive, "encoder_optimizer", encoders_.optimizer);
-    archive.write("log_alpha", log_alpha_.detach());
-    write_generator(archive, "generator", generator_);
-    archive.write("updates", torch::tensor({updates_}, torch::kInt64));
-  });
+  write_checkpoint(file, header, [&](torch::serialize::OutputArchive& archive) { write(archive); });
 }
 
 long ContextSac::load(const std::filesystem::path& file) {
   const CheckpointInfo info = read_checkpoint(
-      file, "sami_" + method_, [&](const CheckpointInfo&, torch::serialize::InputArchive& archive) {
-        // Every module's shape is checked before anything changes.
-        std::vector<std::function<void()>> copies;
-        copies.push_back(stage_module(archive, "actor", *actor_));
-        check_critic_format(archive, "critic");
-        copies.push_back(stage_module(archive, "critic", *critic_));
-        copies.push_back(stage_module(archive, "critic_target", *critic_target_));
-        copies.push_back(stage_module(archive, "encoder", *encoders_.online));
-        copies.push_back(stage_module(archive, "encoder_target", *encoders_.target));
-        copies.push_back(stage_module(archive, "bilinear", *encoders_.bilinear));
-        for (const auto& copy : copies) copy();
-        read_optimizer(archive, "actor_optimizer", actor_optimizer_);
-        read_optimizer(archive, "critic_optimizer", critic_optimizer_);
-        read_optimizer(archive, "alpha_optimizer", alpha_optimizer_);
-        read_optimizer(archive, "encoder_optimizer", encoders_.optimizer);
-        torch::Tensor log_alpha, updates;
-        archive.read("log_alpha", log_alpha);
-        {
-          torch::NoGradGuard no_grad;
-          log_alpha_.copy_(log_alpha);
-        }
-        read_generator(archive, "generator", generator_);
-        archive.read("updates", updates);
-        updates_ = updates.item<long>();
-      });
+      file, "sami_" + method_,
+      [&](const CheckpointInfo&, torch::serialize::InputArchive& archive) { read(archive)(); });
   return info.steps;
+}
+
+void ContextSac::write(torch::serialize::OutputArchive& archive) const {
+  write_module(archive, "actor", *actor_);
+  write_module(archive, "critic", *critic_);
+  write_module(archive, "critic_target", *critic_target_);
+  write_module(archive, "encoder", *encoders_.online);
+  write_module(archive, "encoder_target", *encoders_.target);
+  write_module(archive, "bilinear", *encoders_.bilinear);
+  write_optimizer(archive, "actor_optimizer", actor_optimizer_);
+  write_optimizer(archive, "critic_optimizer", critic_optimizer_);
+  write_optimizer(archive, "alpha_optimizer", alpha_optimizer_);
+  write_optimizer(archive, "encoder_optimizer", encoders_.optimizer);
+  archive.write("log_alpha", log_alpha_.detach());
+  write_generator(archive, "generator", generator_);
+  archive.write("updates", torch::tensor({updates_}, torch::kInt64));
+}
+
+std::function<void()> ContextSac::read(torch::serialize::InputArchive& archive) {
+  // Every module's shape is checked before anything changes.
+  std::vector<std::function<void()>> copies;
+  copies.push_back(stage_module(archive, "actor", *actor_));
+  check_critic_format(archive, "critic");
+  copies.push_back(stage_module(archive, "critic", *critic_));
+  copies.push_back(stage_module(archive, "critic_target", *critic_target_));
+  copies.push_back(stage_module(archive, "encoder", *encoders_.online));
+  copies.push_back(stage_module(archive, "encoder_target", *encoders_.target));
+  copies.push_back(stage_module(archive, "bilinear", *encoders_.bilinear));
+  return [this, &archive, copies = std::move(copies)] {
+    for (const auto& copy : copies) copy();
+    read_optimizer(archive, "actor_optimizer", actor_optimizer_);
+    read_optimizer(archive, "critic_optimizer", critic_optimizer_);
+    read_optimizer(archive, "alpha_optimizer", alpha_optimizer_);
+    read_optimizer(archive, "encoder_optimizer", encoders_.optimizer);
+    torch::Tensor log_alpha, updates;
+    archive.read("log_alpha", log_alpha);
+    {
+      torch::NoGradGuard no_grad;
+      log_alpha_.copy_(log_alpha);
+    }
+    read_generator(archive, "generator", generator_);
+    archive.read("updates", updates);
+    updates_ = updates.item<long>();
+  };
+}
+
+std::vector<torch::Tensor> ContextSac::parameters() const {
+  std::vector<torch::Tensor> out;
+  const auto add = [&out](const torch::nn::Module& module) {
+    for (const torch::Tensor& p : module.parameters()) out.push_back(p);
+  };
+  add(*actor_);
+  add(*critic_);
+  add(*critic_target_);
+  add(*encoders_.online);
+  add(*encoders_.target);
+  add(*encoders_.bilinear);
+  out.push_back(log_alpha_);
+  return out;
 }
 
 }  // namespace cradle::learn::meta

@@ -14,6 +14,7 @@
 #include <torch/torch.h>
 
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <string>
@@ -114,6 +115,16 @@ class ContextSac {
   void save(const std::filesystem::path& file, long steps) const;
   // Returns the saved steps; UserError for another method or shapes.
   long load(const std::filesystem::path& file);
+  // The body of those checkpoints, for a learner that stores ContextSac beside parts of its own
+  // under its own header (learn/meta/sami_learner.h). read() checks every module's shape
+  // (UserError; nothing changes) and returns the copy, to run on the same archive once the
+  // learner's own parts have passed their checks too.
+  void write(torch::serialize::OutputArchive& archive) const;
+  std::function<void()> read(torch::serialize::InputArchive& archive);
+
+  // Every trained tensor (actor, critics and their target, both encoders, W, log alpha), e.g.
+  // for learn/grad_sync.h's tensor_hash.
+  std::vector<torch::Tensor> parameters() const;
 
  private:
   std::string method_;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 
 #include "core/error.h"
 #include "learn/replay_buffer.h"
@@ -133,6 +135,88 @@ TrajectoryReplay::Batch TrajectoryReplay::gather(const std::vector<long>& indice
   batch.prev_actions.narrow(1, 1, t - 1).copy_(batch.actions.narrow(1, 0, t - 1));
   batch.valid = (torch::arange(t).unsqueeze(0) < batch.lengths.unsqueeze(1)).to(torch::kFloat32);
   return batch;
+}
+
+namespace {
+
+template <typename T>
+constexpr torch::Dtype dtype_of() {
+  if constexpr (std::is_same_v<T, float>) return torch::kFloat32;
+  if constexpr (std::is_same_v<T, double>) return torch::kFloat64;
+  if constexpr (std::is_same_v<T, int>) return torch::kInt32;
+  return torch::kUInt8;
+}
+
+// A copy of an array as a 1-D tensor of its own type.
+template <typename T>
+torch::Tensor to_tensor(const std::vector<T>& values) {
+  torch::Tensor out = torch::empty({static_cast<long>(values.size())}, dtype_of<T>());
+  std::copy(values.begin(), values.end(), out.data_ptr<T>());
+  return out;
+}
+
+// Reads `name` for `values`: UserError unless it has the array's type and size.
+template <typename T>
+torch::Tensor read_array(torch::serialize::InputArchive& archive, const std::string& name,
+                         const std::vector<T>& values) {
+  torch::Tensor stored;
+  archive.read(name, stored);
+  if (stored.scalar_type() != dtype_of<T>() || stored.dim() != 1 ||
+      stored.numel() != static_cast<long>(values.size())) {
+    throw UserError("sami replay: " + name + " holds " + std::to_string(stored.numel()) +
+                    " values in the checkpoint, " + std::to_string(values.size()) +
+                    " here (the number of envs, buffer_size, horizon and the spaces must match)");
+  }
+  return stored.contiguous();
+}
+
+template <typename T>
+void copy_array(const torch::Tensor& stored, std::vector<T>& values) {
+  const T* data = stored.data_ptr<T>();
+  std::copy(data, data + values.size(), values.begin());
+}
+
+}  // namespace
+
+void TrajectoryReplay::write(torch::serialize::OutputArchive& archive,
+                             const std::string& key) const {
+  torch::serialize::OutputArchive nested(archive.compilation_unit());
+  nested.write("observations", to_tensor(observations_));
+  nested.write("actions", to_tensor(actions_));
+  nested.write("rewards", to_tensor(rewards_));
+  nested.write("length", to_tensor(length_));
+  nested.write("terminated", to_tensor(terminated_));
+  nested.write("average_return", to_tensor(average_return_));
+  nested.write("head", to_tensor(head_));
+  nested.write("filled", to_tensor(filled_));
+  nested.write("open", to_tensor(open_));
+  archive.write(key, nested);
+}
+
+std::function<void()> TrajectoryReplay::stage(torch::serialize::InputArchive& archive,
+                                              const std::string& key) {
+  torch::serialize::InputArchive nested;
+  archive.read(key, nested);
+  const torch::Tensor observations = read_array(nested, "observations", observations_);
+  const torch::Tensor actions = read_array(nested, "actions", actions_);
+  const torch::Tensor rewards = read_array(nested, "rewards", rewards_);
+  const torch::Tensor length = read_array(nested, "length", length_);
+  const torch::Tensor terminated = read_array(nested, "terminated", terminated_);
+  const torch::Tensor average_return = read_array(nested, "average_return", average_return_);
+  const torch::Tensor head = read_array(nested, "head", head_);
+  const torch::Tensor filled = read_array(nested, "filled", filled_);
+  const torch::Tensor open = read_array(nested, "open", open_);
+  return [=, this] {
+    copy_array(observations, observations_);
+    copy_array(actions, actions_);
+    copy_array(rewards, rewards_);
+    copy_array(length, length_);
+    copy_array(terminated, terminated_);
+    copy_array(average_return, average_return_);
+    copy_array(head, head_);
+    copy_array(filled, filled_);
+    copy_array(open, open_);
+  };
 }
 
 torch::Tensor TrajectoryReplay::Batch::encoder_input() const {

@@ -9,7 +9,9 @@
 
 #include <torch/torch.h>
 
+#include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/rng.h"
@@ -60,6 +62,13 @@ class TrajectoryReplay {
     torch::Tensor encoder_input() const;
   };
   Batch gather(const std::vector<long>& indices) const;
+
+  // Checkpoints (learn/meta/sami_learner.h): every trajectory, open ones included, and the
+  // ring's counters in a nested archive under `key`. stage() checks every size against this
+  // replay's (UserError naming the first mismatch; nothing changes) and returns the copy, to run
+  // once every other part of the checkpoint has passed its checks.
+  void write(torch::serialize::OutputArchive& archive, const std::string& key) const;
+  std::function<void()> stage(torch::serialize::InputArchive& archive, const std::string& key);
 
  private:
   long slot(int env, int k) const { return static_cast<long>(env) * capacity_ + k; }
