@@ -18,5 +18,6 @@ void register_tma_campaign(CLI::App& tma);  // under `tma`: campaign, analyze
 void register_sami(CLI::App& app);
 void register_launch(CLI::App& app);
 void register_soak(CLI::App& app);
+void register_envs(CLI::App& app);
 
 }  // namespace cradle::apps

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
       installed ? installed->string() : std::string(CRADLE_SOURCE_DIR) + " (source tree)";
   app.set_version_flag("--version", std::string(CRADLE_VERSION) + "\ndata files: " + data);
   app.require_subcommand(1);
+  cradle::apps::register_envs(app);
   cradle::apps::register_build_scene(app);
   cradle::apps::register_model_info(app);
   cradle::apps::register_bench(app);

@@ -1,6 +1,7 @@
 // `cradle train --config FILE --algo ppo --intrinsic NAME[,NAME...] --steps N --envs K --seed S
-// [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it. `--env NAME`
-// instead of --config trains a MIMo sample env (e.g. with --task-space and --teacher).
+// [--resume] [--randomize-start]`: trains a policy, checkpoints it and evaluates it. `--env ID`
+// instead of --config trains any registered env (`cradle envs`; e.g. with --task-space and
+// --teacher); a BabyBench id trains its config.
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "dist/process_group.h"
+#include "envs/registry.h"
 #include "train/dist_sync.h"
 #include "train/trainer.h"
 
@@ -61,7 +63,7 @@ void register_train(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("train", "Train a policy with intrinsic motivation");
   cmd->add_option("--config", opts->config, "BabyBench YAML config (or --env)");
   cmd->add_option("--env", opts->train.env,
-                  "A MIMo sample env instead: reach, standup, selfbody or catch");
+                  "An env id instead (`cradle envs`: babybench/..., mimo/..., tma/..., sami/...)");
   cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--algo", opts->train.algorithm, "Learning algorithm")
       ->check(CLI::IsMember({"ppo", "a2c", "sac", "td3", "ddpg"}));
@@ -125,21 +127,33 @@ void register_train(CLI::App& app) {
     }
     // A BabyBench config or a MIMo sample env (its run folder: --save-dir, else results/<env>).
     Config config;
+    if (!opts->train.env.empty() && !opts->config.empty())
+      throw UserError("--config and --env " + opts->train.env + ": give one of them");
+    // A BabyBench id trains its config, with everything a config run has.
+    bool babybench_id = false;
+    if (!opts->train.env.empty()) {
+      const envs::EnvSpec spec = envs::env_spec(train::registered_env_id(opts->train.env));
+      if (spec.family == "babybench") {
+        config = spec.config.empty() ? default_config() : load_config(spec.config);
+        opts->train.env.clear();
+        babybench_id = true;
+      }
+    }
     if (opts->train.env.empty()) {
-      if (opts->config.empty()) throw UserError("give --config FILE.yml (BabyBench) or --env NAME");
-      config = load_config(opts->config);
+      if (opts->config.empty() && !babybench_id)
+        throw UserError("give --config FILE.yml (BabyBench) or --env ID (`cradle envs`)");
+      if (!babybench_id) config = load_config(opts->config);
     } else {
-      if (!opts->config.empty())
-        throw UserError("--config and --env " + opts->train.env + ": give one of them");
-      for (const char* flag : {"--intrinsic", "--randomize-start", "--compare-random",
-                               "--eval-episodes", "--no-eval-video", "--distributed"}) {
+      for (const char* flag :
+           {"--randomize-start", "--compare-random", "--eval-episodes", "--no-eval-video"}) {
         if (cmd->get_option(flag)->count() > 0)
           throw UserError(std::string(flag) + " is for BabyBench configs, not --env " +
                           opts->train.env);
       }
-      opts->train.intrinsic.clear();  // the sample task's own reward
+      // The env's own reward unless intrinsic rewards are asked for.
+      if (cmd->get_option("--intrinsic")->count() == 0) opts->train.intrinsic.clear();
       opts->train.eval_episodes = 0;
-      config.save_dir = "results/" + opts->train.env;
+      config.save_dir = "results/" + train::registered_env_id(opts->train.env);
     }
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     for (const std::string& kv : opts->hp) {

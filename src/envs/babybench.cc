@@ -12,6 +12,9 @@
 namespace cradle::envs {
 namespace {
 
+// The cubes' distance from MIMo a curriculum may set (m).
+constexpr double kCubeDistance[2] = {0.1, 0.8};
+
 using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -166,7 +169,7 @@ void BabyBenchEnv::set_reset_options(const ResetOptions& options) {
       if (cube_qpos_.size() != 3) {
         throw UserError("reset option cube_distance needs the cubes scene (scene: cubes)");
       }
-      if (!(value >= 0.1 && value <= 0.8)) {
+      if (!(value >= kCubeDistance[0] && value <= kCubeDistance[1])) {
         throw UserError("reset option cube_distance must be in [0.1, 0.8] m, not " +
                         std::to_string(value));
       }
@@ -291,6 +294,13 @@ StepResult BabyBenchEnv::step(std::span<const double> action) {
   profile.other += seconds(Clock::now() - task_start);
   ++profile.steps;
   return result;
+}
+
+std::vector<TaskParameter> babybench_task_parameters(const Config& config) {
+  std::vector<TaskParameter> out = {{"start_posture_range", 0, 1}, {"randomize_start", 0, 1}};
+  if (config.scene == SceneKind::kCubes)
+    out.push_back({"cube_distance", kCubeDistance[0], kCubeDistance[1]});
+  return out;
 }
 
 }  // namespace cradle::envs

@@ -50,6 +50,10 @@ std::shared_ptr<const BabyBenchAssets> make_assets(const Config& config,
 // holds that many entries (a resumed run).
 std::shared_ptr<TrainingLog> start_training(const BabyBenchAssets& assets, long continue_log = -1);
 
+// The reset options a teacher can set on a config's env (set_reset_options), with their ranges:
+// start_posture_range, randomize_start, and cube_distance in the cubes scene.
+std::vector<TaskParameter> babybench_task_parameters(const Config& config);
+
 // The observation space a config produces, without building an env (no GL context needed).
 DictSpace babybench_observation_space(const BabyBenchAssets& assets, int actuation_obs_size);
 

@@ -57,6 +57,13 @@ struct ObservationLayout {
 // Options an env applies at every later reset (randomized starts, a teacher's task parameters).
 using ResetOptions = std::map<std::string, double, std::less<>>;
 
+// A reset option a teacher can set, with the range the env accepts (envs/registry.h lists each
+// env's).
+struct TaskParameter {
+  std::string name;
+  double low = 0, high = 0;
+};
+
 struct StepResult {
   double reward = 0;
   bool terminated = false;

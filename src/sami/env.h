@@ -109,6 +109,11 @@ class SamiEnv {
   virtual std::span<const double> action_mask() const { return {}; }
   const Info& info() const { return info_; }
   const std::vector<TaskSet>& task_sets() const { return sets_; }
+  // The task sets of the following resets (a teacher's choice); UserError for invalid ones.
+  void set_task_sets(std::vector<TaskSet> sets) {
+    validate(spec_.id, sets);
+    sets_ = std::move(sets);
+  }
 
   // The env's model: the shared one with this env's hidden parameters (read it, never write it).
   const mjModel* model() const { return &model_; }

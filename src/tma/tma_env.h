@@ -85,6 +85,8 @@ class TmaEnv {
   TmaEnv& operator=(const TmaEnv&) = delete;
 
   const TmaOptions& options() const { return options_; }
+  // Parkour's CPPN (null on Stump Tracks), to share with more envs of the same options.
+  const std::shared_ptr<const Cppn>& cppn() const { return cppn_; }
   int observation_size() const { return static_cast<int>(obs_.size()); }
   int action_size() const { return action_size_; }
 

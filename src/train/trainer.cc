@@ -14,7 +14,7 @@
 #include "core/error.h"
 #include "core/jsonl.h"
 #include "envs/babybench.h"
-#include "envs/mimo/sample_env.h"
+#include "envs/registry.h"
 #include "eval/figures.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
@@ -27,7 +27,7 @@
 #include "train/babybench_vector.h"
 #include "train/curriculum_env.h"
 #include "train/loop.h"
-#include "train/sample_vector.h"
+#include "train/env_vector.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -135,6 +135,13 @@ bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& sc
 
 }  // namespace
 
+std::string registered_env_id(const std::string& name) {
+  // `cradle illustrate`'s short names of the MIMo sample tasks.
+  for (const char* short_name : {"reach", "standup", "selfbody", "catch"})
+    if (name == short_name) return "mimo/" + name;
+  return envs::env_spec(name).id;  // UserError naming the closest ids
+}
+
 TrainResult train(const Config& config, const TrainOptions& options) {
   if (options.steps < 1) throw UserError("--steps must be at least 1");
   if (options.envs < 1) throw UserError("--envs must be at least 1");
@@ -152,18 +159,17 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (options.async_batch != 0) throw UserError("--procs and --async-batch: give one of them");
     if (!options.task_space.empty()) throw UserError("--procs is not available with --task-space");
   }
-  // A sample env has none of BabyBench's extras.
-  const bool sample = !options.env.empty();
-  if (sample) {
-    envs::sample_env_id(options.env);  // UserError for an unknown name
-    if (!options.intrinsic.empty())
-      throw UserError("--intrinsic is for BabyBench configs; --env " + options.env +
-                      " trains on the sample task's own reward");
+  // An env by id (any family but BabyBench's configs, which train as configs) has none of
+  // BabyBench's extras: no training log, start randomisation or final evaluation.
+  const bool by_id = !options.env.empty();
+  const std::string env_id = by_id ? registered_env_id(options.env) : "";
+  if (by_id) {
+    if (envs::env_spec(env_id).family == "babybench")
+      throw UserError("--env " + options.env + " is a BabyBench config: train it as --config " +
+                      "(cradle train --env does that for you)");
     if (options.randomize_start || options.compare_random)
       throw UserError(
           "--randomize-start and --compare-random are for BabyBench configs, not --env");
-    if (distributed(options.sync.get()))
-      throw UserError("--distributed trains BabyBench configs, not --env");
   }
   const fs::path dir = config.save_dir;
   const fs::path checkpoints = dir / "checkpoints";
@@ -233,7 +239,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (rank > 0) env_config.save_dir = (dir / "ranks" / std::to_string(rank)).string();
   const fs::path log_file = fs::path(env_config.save_dir) / "logs" / "training.jsonl";
   const long kept_episodes =
-      options.resume && !sample
+      options.resume && !by_id
           ? cut_training_log(log_file,
                              rank == 0 ? resumed.episodes : std::numeric_limits<long>::max())
           : -1;
@@ -269,15 +275,17 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     teacher_log->flush();
   };
   // A resumed run's first resets end no episode of this run's log.
-  if (sample) {
-    std::error_code made;
-    fs::create_directories(dir / "logs", made);
-    if (made) throw UserError("cannot create '" + (dir / "logs").string() + "': " + made.message());
+  if (by_id) {
+    for (const fs::path& logs : {dir / "logs", fs::path(env_config.save_dir) / "logs"}) {
+      std::error_code made;
+      fs::create_directories(logs, made);
+      if (made) throw UserError("cannot create '" + logs.string() + "': " + made.message());
+    }
   }
   TrainingVector training =
-      sample
-          ? make_sample_training(options.env, options.envs, options.threads, options.seed, wrap,
-                                 options.async_batch)
+      by_id
+          ? make_env_training(env_id, options.envs, options.threads, options.seed + rank, wrap,
+                              options.async_batch)
           : make_babybench_training(env_config, options.envs, options.threads, options.seed + rank,
                                     kept_episodes, wrap, options.async_batch, options.procs);
   std::unique_ptr<VecEnv>& vec = training.vec;
@@ -404,10 +412,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
 
-    // A sample env has no behaviour score.
+    // Only BabyBench scores behaviour.
     bar.show(s.steps, elapsed,
              "return " + csv_cell(s.episodic_return) +
-                 (sample ? "" : "  score " + csv_cell(last_score)));
+                 (by_id ? "" : "  score " + csv_cell(last_score)));
     return true;
   };
   // Learning stops at each checkpoint (an episode boundary) and continues in a new learn() call.
@@ -449,12 +457,12 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (rank > 0) return result;  // rank 0 draws, scores and evaluates the run
   if (!rows.empty()) plot_curves(rows, dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
-  if (!sample && fs::exists(log_file))
+  if (!by_id && fs::exists(log_file))
     result.training_score = eval::training_score(
         config.behavior, eval::read_training_log(log_file, config.behavior, training.geom_count));
 
   // The trained policy's evaluation, acting deterministically.
-  if (!sample && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
+  if (!by_id && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
     train::EvaluationOptions eo{.episodes = options.eval_episodes,
                                 .duration = options.eval_duration,
                                 .render = options.eval_render,

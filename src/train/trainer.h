@@ -19,9 +19,11 @@
 namespace cradle::train {
 
 struct TrainOptions {
-  // A MIMo sample env (reach, standup, selfbody, catch) instead of the config's BabyBench env: the
-  // same loop, checkpoints, progress.csv and curriculum, without BabyBench's training log,
-  // intrinsic rewards (intrinsic must be empty), start randomisation and final evaluation.
+  // An env id of any family (envs/registry.h; `cradle envs`) but BabyBench's configs, which train
+  // as configs, instead of the config's BabyBench env: the same loop, checkpoints, progress.csv,
+  // curriculum, intrinsic rewards (those whose observations the env has) and data-parallel
+  // ranks, without BabyBench's training log, start randomisation and final evaluation. The MIMo
+  // sample tasks' short names (reach, standup, selfbody, catch) are accepted too.
   std::string env;
   // With resume: empty continues the checkpoint's algorithm, another name is refused.
   std::string algorithm = "ppo";
@@ -77,6 +79,10 @@ struct TrainResult {
   std::filesystem::path checkpoint;
   std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };
+
+// The registered id of an env name: an id, an alias or a MIMo sample task's short name. UserError
+// naming the closest ids for an unknown one.
+std::string registered_env_id(const std::string& name);
 
 // With options.env set, only config.save_dir is read.
 TrainResult train(const Config& config, const TrainOptions& options);

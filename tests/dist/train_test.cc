@@ -82,6 +82,37 @@ TEST_P(Launch, TwoRanksEndWithBitwiseIdenticalParameters) {
 
 INSTANTIATE_TEST_SUITE_P(Learners, Launch, testing::Values("ppo", "a2c", "sac"));
 
+// Every env family trains data-parallel through the same run: TeachMyAgent and SaMI by id, 2 ranks,
+// the same parameters on both at the end.
+class LaunchById : public testing::TestWithParam<std::pair<std::string, std::string>> {};
+
+TEST_P(LaunchById, TwoRanksEndWithBitwiseIdenticalParameters) {
+  const auto& [env, algo] = GetParam();
+  const fs::path dir = fresh_dir("dist_by_id_" + algo);
+  std::string hp = " --hp n_steps=32 batch_size=16 n_epochs=2";
+  if (algo == "sac")
+    hp = " --hp learning_starts=16 batch_size=16 buffer_size=2000 report_every=16 "
+         "pi_layers=32,32 qf_layers=32,32";
+  const RunResult r = run_cradle("launch --nproc 2 -- cradle train --env " + env + " --algo " +
+                                 algo + " --envs 1 --threads 1 --steps 128 --checkpoint-every 64 "
+                                 "--seed 5 --dist-timeout 30 --save-dir " +
+                                 (dir / "run").string() + hp);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::map<int, std::string> h = hashes(r.out);
+  ASSERT_EQ(h.size(), 2u) << r.out;
+  EXPECT_EQ(h.at(0), h.at(1));
+  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), 128);
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Families, LaunchById,
+    testing::Values(std::pair<std::string, std::string>{"tma/stump-tracks:old_classic_bipedal",
+                                                        "ppo"},
+                    std::pair<std::string, std::string>{"sami/CrippleHalfCheetah", "sac"}),
+    [](const auto& info) { return info.param.second + "_" + std::to_string(info.index); });
+
 TEST(Launch, AFailingRankStopsTheOthersAndIsNamed) {
   const auto start = std::chrono::steady_clock::now();
   const RunResult r = run_cradle(

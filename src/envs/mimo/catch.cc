@@ -217,6 +217,12 @@ SampleDefinition catch_definition() {
                        .actuation = ActuationModel::kMuscle,
                        .touch = kSkin,
                        .extra_observation = 1};
+  def.parameters = {{"ball_dx", -kOptionOffset, kOptionOffset},
+                    {"ball_dy", -kOptionOffset, kOptionOffset},
+                    {"ball_dz", -kOptionOffset, kOptionOffset},
+                    {"ball_speed", 0, kOptionSpeed},
+                    {"ball_radius", kOptionRadius[0], kOptionRadius[1]},
+                    {"ball_mass", kOptionMass[0], kOptionMass[1]}};
   // The reference's view: tracking the root, looking at the hand from the side.
   def.camera_lookat = {0.15, -0.04, 0.6};
   def.camera_distance = 0.5;

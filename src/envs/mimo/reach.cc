@@ -89,6 +89,8 @@ class Reach final : public SampleTask {
 
 SampleDefinition reach_definition() {
   SampleDefinition def{.name = "MIMoReach-v0", .max_episode_steps = 1000};
+  for (const char* name : {"target_dx", "target_dy", "target_dz"})
+    def.parameters.push_back({name, -kOptionRange, kOptionRange});
   def.camera_lookat = {0.15, -0.1, 0.6};
   def.camera_distance = 1.0;
   def.camera_azimuth = 135;

@@ -17,14 +17,17 @@ using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-// The registry, in the reference's registration order.
-const std::vector<SampleDefinition>& definitions() {
+}  // namespace
+
+const std::vector<SampleDefinition>& sample_definitions() {
   static const std::vector<SampleDefinition> all = {
       bench_definition(false), bench_definition(true), showroom_definition(), reach_definition(),
       standup_definition(),    selfbody_definition(),  catch_definition(),
   };
   return all;
 }
+
+namespace {
 
 std::string joined_names() {
   std::string names;
@@ -37,7 +40,7 @@ std::string joined_names() {
 const std::vector<std::string>& sample_env_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
-    for (const SampleDefinition& d : definitions()) out.push_back(d.name);
+    for (const SampleDefinition& d : sample_definitions()) out.push_back(d.name);
     return out;
   }();
   return names;
@@ -99,7 +102,7 @@ int body_id(const mjModel* m, const std::string& body) {
 
 std::shared_ptr<const SampleAssets> make_sample_assets(std::string_view name,
                                                        const SampleOptions& options) {
-  const auto& all = definitions();
+  const auto& all = sample_definitions();
   const auto it = std::ranges::find(all, name, &SampleDefinition::name);
   if (it == all.end()) {
     throw UserError("unknown sample env '" + std::string(name) + "'; expected one of " +

@@ -68,6 +68,8 @@ struct SampleDefinition {
   double camera_distance = 1.5, camera_azimuth = 150, camera_elevation = -20;
   // The scene; the core adds the free-view camera.
   std::function<scene::Composition(const SampleOptions&)> scene;
+  // The reset options a teacher can set (set_reset_options), with their ranges.
+  std::vector<TaskParameter> parameters;
   // Writes the start state into d (already reset and forwarded); the core saves it as `init`.
   std::function<void(const mjModel*, mjData*)> initial_state;
   // The task of an env on its core (a task that changes the model per episode makes the core's
@@ -88,6 +90,8 @@ struct SampleAssets {
   int camera = -1;                       // id of the free-view camera "view"
 };
 
+// Every sample task's definition, in the reference's registration order.
+const std::vector<SampleDefinition>& sample_definitions();
 // Registered names, in the reference's order.
 const std::vector<std::string>& sample_env_names();
 // Short names of `cradle illustrate` (reach, standup, selfbody, catch) -> registered names.

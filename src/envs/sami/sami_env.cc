@@ -1,6 +1,9 @@
 #include "envs/sami/sami_env.h"
 
 #include <algorithm>
+#include <string>
+
+#include "core/error.h"
 
 #include "envs/action_check.h"
 
@@ -11,7 +14,41 @@ SamiEnvAdapter::SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env)
       space_(env_->spec().observation_space()),
       action_space_(env_->spec().action_space()),
       buffers_(space_),
-      success_slot_(info_.declare("is_success", InfoType::kBool)) {}
+      success_slot_(info_.declare("is_success", InfoType::kBool)),
+      base_sets_(env_->task_sets()) {}
+
+void SamiEnvAdapter::set_reset_options(const ResetOptions& options) {
+  const sami::Varies varies = sami::env_varies(env_->spec().id);
+  const std::string env(env_->spec().name);
+  auto value = [&](const std::string& name, double v, const double range[2]) {
+    if (!(v >= range[0] && v <= range[1])) {
+      throw UserError("reset option " + name + " = " + std::to_string(v) + " is out of range for " +
+                      env + " (expected [" + std::to_string(range[0]) + ", " +
+                      std::to_string(range[1]) + "])");
+    }
+    return v;
+  };
+  std::vector<sami::TaskSet> sets = base_sets_;
+  for (const auto& [name, v] : options) {
+    const bool factor = (name == "mass" && varies.mass) || (name == "damping" && varies.damping);
+    const bool cell = (name == "table_friction" || name == "cube_mass") && varies.cells;
+    if (!factor && !cell) {
+      std::string known;
+      if (varies.mass) known += "mass";
+      if (varies.damping) known += known.empty() ? "damping" : ", damping";
+      if (varies.cells) known += "table_friction, cube_mass";
+      throw UserError("reset option '" + name + "' is not a hidden parameter of " + env +
+                      " (expected " + (known.empty() ? "none" : known) + ")");
+    }
+    const double x = value(name, v, factor ? kFactorRange : kCellRange);
+    for (sami::TaskSet& s : sets) {
+      if (name == "mass") s.mass = {x};
+      if (name == "damping") s.damping = {x};
+      for (auto& c : s.cells) c[name == "table_friction" ? 0 : 1] = x;
+    }
+  }
+  env_->set_task_sets(std::move(sets));
+}
 
 void SamiEnvAdapter::copy_observation() {
   // Key i of the family's flat float32 observation goes to buffer i.
@@ -34,6 +71,27 @@ StepResult SamiEnvAdapter::step(std::span<const double> action) {
   const sami::StepResult r = env_->step(action);
   copy_observation();
   return {.reward = r.reward, .terminated = r.terminated, .truncated = r.truncated};
+}
+
+std::vector<sami::TaskSet> sami_vector_sets(sami::EnvId id, std::string_view split_or_file) {
+  std::vector<sami::TaskSet> sets = sami::task_sets(id, split_or_file);
+  if (sets.size() != 1) return sets;
+  const sami::TaskSet one = sets[0];
+  std::vector<sami::TaskSet> out;
+  if (one.cripple.size() > 1) {
+    for (const auto& choice : one.cripple) {
+      sami::TaskSet s = one;
+      s.cripple = {choice};
+      out.push_back(s);
+    }
+  } else if (one.mass.size() > 1) {
+    for (double m : one.mass) {
+      sami::TaskSet s = one;
+      s.mass = {m};
+      out.push_back(s);
+    }
+  }
+  return out.empty() ? sets : out;
 }
 
 std::unique_ptr<Env> make_sami_env(std::string_view name, std::string_view split,

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include "envs/env.h"
 #include "sami/env.h"
@@ -12,6 +13,11 @@ namespace cradle::envs {
 
 class SamiEnvAdapter final : public Env {
  public:
+  // The hidden parameters a teacher may set, as reset options: mass and damping factors
+  // (locomotion envs that vary them) and Panda's table_friction and cube_mass (kg).
+  static constexpr double kFactorRange[2] = {0.05, 5};
+  static constexpr double kCellRange[2] = {0.01, 50};
+
   explicit SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env);
   const DictSpace& observation_space() const override { return space_; }
   const Box& action_space() const override { return action_space_; }
@@ -19,6 +25,10 @@ class SamiEnvAdapter final : public Env {
   StepResult step(std::span<const double> action) override;
   const ObservationBuffers& observation() const override { return buffers_; }
   const Info& info() const override { return info_; }
+  // Fixes the named hidden parameters in every task set for the following resets (the rest are
+  // still drawn from the sets); UserError for a name the env does not vary or a value out of
+  // range, before anything changes.
+  void set_reset_options(const ResetOptions& options) override;
   sami::SamiEnv& sami() { return *env_; }
 
  private:
@@ -29,7 +39,13 @@ class SamiEnvAdapter final : public Env {
   ObservationBuffers buffers_;
   Info info_;
   int success_slot_ = -1;  // info "is_success"
+  std::vector<sami::TaskSet> base_sets_;  // the sets the env was made with
 };
+
+// The task sets of a vector of SaMI envs, one per env (SaMI's DummyVecEnv): the split's (or YAML
+// file's) sets, where a single set that varies its crippling (or else its mass) is split into one
+// set per choice so that the methods that contrast envs have more than one.
+std::vector<sami::TaskSet> sami_vector_sets(sami::EnvId id, std::string_view split_or_file);
 
 // A SaMI env by name and split (or task-set YAML file) behind the Env interface.
 std::unique_ptr<Env> make_sami_env(std::string_view name, std::string_view split,

@@ -82,4 +82,21 @@ void TmaEnvAdapter::copy_observation() {
                          [](double v) { return static_cast<float>(v); });
 }
 
+std::vector<TaskParameter> tma_task_parameters(tma::EnvId env, int input_cppn_dim) {
+  if (env == tma::EnvId::kStumpTracks) return {{"stump_height", 0, 3}, {"obstacle_spacing", 0, 6}};
+  std::vector<TaskParameter> out;
+  const double standard[3][2] = {{-0.35, 0.05}, {0.6, 1.0}, {-0.1, 0.3}};
+  for (int k = 0; k < input_cppn_dim; ++k) {
+    const bool three = input_cppn_dim == 3;
+    out.push_back({"input_vector_" + std::to_string(k), three ? standard[k][0] : -1.0,
+                   three ? standard[k][1] : 1.0});
+  }
+  out.insert(out.end(), {{"water_level", 0, 1},
+                         {"creepers_width", 0.25, 0.25},
+                         {"creepers_height", 0, 4},
+                         {"creepers_spacing", 0, 5},
+                         {"terrain_cppn_scale", 10, 10}});
+  return out;
+}
+
 }  // namespace cradle::envs

@@ -4,11 +4,18 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "envs/env.h"
 #include "tma/tma_env.h"
 
 namespace cradle::envs {
+
+// The benchmark's task space, as reset options a teacher sets: Stump Tracks' stump_height
+// [0, 3] and obstacle_spacing [0, 6] (the criteria's space); Parkour's input_vector_0..k-1 (k =
+// input_cppn_dim; the benchmark's bounds for k = 3, else [-1, 1] each), water_level [0, 1],
+// creepers_width 0.25, creepers_height [0, 4], creepers_spacing [0, 5] and terrain_cppn_scale 10.
+std::vector<TaskParameter> tma_task_parameters(tma::EnvId env, int input_cppn_dim = 3);
 
 class TmaEnvAdapter : public Env {
  public:

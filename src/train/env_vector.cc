@@ -1,0 +1,29 @@
+#include "train/env_vector.h"
+
+#include <memory>
+#include <vector>
+
+namespace cradle::train {
+
+TrainingVector make_env_training(const std::string& id, int num_envs, int threads,
+                                 std::uint64_t seed, const EnvWrapper& wrap, int async_batch,
+                                 const envs::EnvOptions& options) {
+  using learn::ThreadedVecEnv;
+  const envs::EnvMaker maker = envs::env_maker(id, options);
+  TrainingVector out;
+  auto make = [&](int i) {
+    std::unique_ptr<envs::Env> env = maker(i, ThreadedVecEnv::env_seed(seed, i));
+    return wrap ? wrap(std::move(env)) : std::move(env);
+  };
+  if (async_batch > 0) {
+    std::vector<std::unique_ptr<envs::Env>> list;
+    for (int i = 0; i < num_envs; ++i) list.push_back(make(i));
+    out.vec = std::make_unique<learn::AsyncVecEnv>(std::move(list), async_batch, threads);
+  } else {
+    out.vec = std::make_unique<ThreadedVecEnv>(num_envs, make, threads);
+  }
+  out.end_episodes = [] {};
+  return out;
+}
+
+}  // namespace cradle::train

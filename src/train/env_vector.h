@@ -1,0 +1,21 @@
+// A vector of envs of one registered id (envs/registry.h) for `cradle train --env ID`: the
+// family-agnostic half of a training run, as babybench_vector.h is for BabyBench configs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "envs/registry.h"
+#include "train/babybench_vector.h"
+
+namespace cradle::train {
+
+// `num_envs` envs of `id` from one factory (what they share compiled once), env i made with
+// index i and seed ThreadedVecEnv::env_seed(seed, i) and wrapped by `wrap` when given. No training
+// log (log null, end_episodes does nothing). async_batch > 0: an AsyncVecEnv returning batches of
+// that many envs. UserError for an unknown id or option.
+TrainingVector make_env_training(const std::string& id, int num_envs, int threads,
+                                 std::uint64_t seed, const EnvWrapper& wrap = nullptr,
+                                 int async_batch = 0, const envs::EnvOptions& options = {});
+
+}  // namespace cradle::train
