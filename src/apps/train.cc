@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "dist/process_group.h"
 #include "envs/registry.h"
+#include "learn/registry.h"
 #include "train/dist_sync.h"
 #include "train/trainer.h"
 
@@ -66,7 +67,8 @@ void register_train(CLI::App& app) {
                   "An env id instead (`cradle envs`: babybench/..., mimo/..., tma/..., sami/...)");
   cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
   cmd->add_option("--algo", opts->train.algorithm, "Learning algorithm")
-      ->check(CLI::IsMember({"ppo", "a2c", "sac", "td3", "ddpg"}));
+      ->check(CLI::IsMember(learn::algorithm_names()))
+      ->capture_default_str();
   cmd->add_option("--intrinsic", opts->train.intrinsic,
                   "Intrinsic rewards, name[:weight],... ('' for none)");
   cmd->add_option("--steps", opts->train.steps, "Env steps in total")

@@ -15,6 +15,7 @@
 #include "envs/registry.h"
 #include "envs/sami/sami_env.h"
 #include "fixture.h"
+#include "learn/learner.h"
 #include "train/trainer.h"
 
 namespace cradle::test {
@@ -90,6 +91,27 @@ TEST(EnvMatrix, OffPolicyLearnersTrainOnEveryFamily) {
     const train::TrainResult r = short_run(id, algo, 128, root / algo, off);
     EXPECT_EQ(r.steps, 128);
     EXPECT_TRUE(fs::exists(root / algo / "checkpoints" / "final.ckpt"));
+  }
+  fs::remove_all(root);
+}
+
+// SaMI's context learners train through the same run: SaCCM on SaMI's own training sets (one per
+// env) and, across families, TESAC on a MIMo sample task.
+TEST(EnvMatrix, SamiLearnersTrainOnSamiAndOnOtherFamilies) {
+  const fs::path root = fresh_dir("env_matrix_sami_learners");
+  const std::map<std::string, std::string> hp = {
+      {"learning_starts", "100"}, {"train_freq", "50"},   {"gradient_steps", "1"},
+      {"batch_size", "2"},        {"contrast_batch_size", "2"}, {"net_arch", "32,32"},
+      {"lstm_hidden", "16"},      {"horizon", "100"},      {"report_every", "100"}};
+  for (const auto& [id, algo] :
+       std::vector<std::pair<std::string, std::string>>{{"sami/CrippleHalfCheetah", "saccm"},
+                                                        {"mimo/reach", "tesac"}}) {
+    SCOPED_TRACE(id + " " + algo);
+    const fs::path dir = root / algo;
+    const train::TrainResult r = short_run(id, algo, 400, dir, hp);
+    EXPECT_EQ(r.steps, 400);
+    EXPECT_TRUE(fs::exists(dir / "checkpoints" / "final.ckpt"));
+    EXPECT_EQ(learn::read_checkpoint_info(dir / "checkpoints" / "final.ckpt").algorithm, algo);
   }
   fs::remove_all(root);
 }
