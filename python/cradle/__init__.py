@@ -1,16 +1,17 @@
-"""Cradle from Python: BabyBench envs stepped in C++, Gymnasium-shaped.
+"""Cradle from Python: envs stepped in C++, Gymnasium-shaped.
 
     import cradle
     env = cradle.make_env("configs/config_selftouch.yml")      # or a dict of BabyBench keys
     obs, info = env.reset(seed=0)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    env = cradle.make("tma/parkour:fish")                      # any id of cradle.env_ids()
 
 See docs/python.md.
 """
 
 import importlib
 
-from . import sami, spaces, teach
+from . import registry, sami, spaces, teach
 from ._cradle import __version__
 from .env import (
     ENV_IDS,
@@ -21,6 +22,7 @@ from .env import (
     make_env,
     register_gymnasium_envs,
 )
+from .registry import RegistryEnv, env_ids, env_spec, env_specs, gymnasium_id
 from .spaces import HAS_GYMNASIUM
 from .training import evaluate, load_policy, load_training_log, train, training_score
 from .vector import VectorEnv
@@ -44,12 +46,17 @@ __all__ = [
     "ActionWrapper",
     "BabyBenchEnv",
     "ObservationWrapper",
+    "RegistryEnv",
     "RewardWrapper",
     "VectorEnv",
     "Wrapper",
     "__version__",
     "config_dict",
+    "env_ids",
+    "env_spec",
+    "env_specs",
     "evaluate",
+    "gymnasium_id",
     "load_config",
     "load_policy",
     "load_training_log",

@@ -1,4 +1,5 @@
-"""The BabyBench env for Python: Gymnasium's Env protocol around the C++ env.
+"""The BabyBench env for Python: Gymnasium's Env protocol around the C++ env; cradle.make over
+every env id (the other families' envs are cradle.registry's).
 
 Observations: ``reset`` and ``step`` return fresh numpy arrays by default (one memcpy per key per
 step, about 3 µs for the 17,000-value self-touch skin). With ``copy_observations=False`` they
@@ -253,18 +254,39 @@ def make_env(config, training=True, **kwargs):
     return BabyBenchEnv(config, training=training, **kwargs)
 
 
-def make(env_id, training=False, render_mode=None, seed=0, copy_observations=True, **overrides):
-    """As gym.make(env_id): "BabyBench" (documented defaults), "BabyBench-SelfTouch" or
-    "BabyBench-HandRegard" (the reference configs), with config keys overridden by keyword, e.g.
-    make("BabyBench-SelfTouch", touch_scale=2.0, save_dir="/tmp/st"). Unlike make_env, training
-    defaults to False (gym.make writes no logs)."""
-    if env_id.startswith("cradle/"):
-        env_id = env_id[len("cradle/") :]
-    env_id = env_id.rsplit("-v", 1)[0] if env_id.rsplit("-v", 1)[-1].isdigit() else env_id
-    if env_id not in ENV_IDS:
-        raise ValueError(f"unknown env id '{env_id}' (expected one of {', '.join(ENV_IDS)})")
-    file = ENV_IDS[env_id]
-    base = _cradle.default_config() if file is None else load_config(os.path.join(CONFIG_DIR, file))
+def make(env_id, **kwargs):
+    """As gym.make(env_id): any listed env id or alias (cradle.env_specs()), or a Gymnasium id
+    (cradle/...-v0).
+
+    BabyBench ids ("BabyBench", "BabyBench-SelfTouch", "BabyBench-HandRegard",
+    "babybench/<config>" or a YAML path) give a BabyBenchEnv: make(env_id, training=False,
+    render_mode=None, seed=0, copy_observations=True, **overrides) with config keys overridden by
+    keyword, e.g. make("BabyBench-SelfTouch", touch_scale=2.0, save_dir="/tmp/st"); unlike
+    make_env, training defaults to False (gym.make writes no logs).
+
+    Every other id ("mimo/reach", "MIMoReach-v0", "tma/parkour:fish", "sami/CrippleAnt:moderate")
+    gives a cradle.RegistryEnv: make(env_id, seed=0, render_mode=None, **options) with the family's
+    constructor options by keyword. An unknown id raises ValueError naming the closest ids.
+    """
+    if not isinstance(env_id, str):
+        raise ValueError(f"env id must be a string such as 'mimo/reach', not {env_id!r}")
+    name = env_id[len("cradle/"):] if env_id.startswith("cradle/") else env_id
+    name = name.rsplit("-v", 1)[0] if name.rsplit("-v", 1)[-1].isdigit() else name
+    if name in ENV_IDS:
+        file = ENV_IDS[name]
+        return _make_babybench(None if file is None else os.path.join(CONFIG_DIR, file), **kwargs)
+    from . import registry
+
+    spec = registry.env_spec(env_id)
+    if spec.family == "babybench":
+        return _make_babybench(spec.config or None, **kwargs)
+    return registry.RegistryEnv(spec.id, **kwargs)
+
+
+def _make_babybench(config_file, training=False, render_mode=None, seed=0, copy_observations=True,
+                    **overrides):
+    """A BabyBenchEnv of a config file (None: the documented defaults) with keys overridden."""
+    base = _cradle.default_config() if config_file is None else load_config(config_file)
     config = json.loads(base.to_json())
     unknown = sorted(set(overrides) - set(_cradle.config_keys()))
     if unknown:
@@ -280,8 +302,9 @@ def make(env_id, training=False, render_mode=None, seed=0, copy_observations=Tru
 
 
 def register_gymnasium_envs():
-    """Registers "cradle/BabyBench-v0", "cradle/BabyBench-SelfTouch-v0" and
-    "cradle/BabyBench-HandRegard-v0" with Gymnasium (done on import when it is installed)."""
+    """Registers "cradle/BabyBench-v0", "cradle/BabyBench-SelfTouch-v0",
+    "cradle/BabyBench-HandRegard-v0" and every listed id (cradle.registry.gymnasium_id) with
+    Gymnasium (done on import when it is installed)."""
     if _gymnasium is None:
         return
     for env_id in ENV_IDS:
@@ -290,3 +313,6 @@ def register_gymnasium_envs():
             _gymnasium.register(
                 id=full_id, entry_point="cradle.env:make", kwargs={"env_id": env_id}
             )
+    from . import registry
+
+    registry.register_gymnasium_envs()

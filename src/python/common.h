@@ -2,11 +2,13 @@
 // spaces, info dicts, and the registration functions of each binding file.
 #pragma once
 
+#include <mujoco/mujoco.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -14,6 +16,10 @@
 #include "core/config.h"
 #include "core/spaces.h"
 #include "envs/env.h"
+
+namespace cradle::sami {
+class SamiEnv;
+}  // namespace cradle::sami
 
 namespace cradle::python {
 
@@ -55,11 +61,23 @@ auto without_gil(Work&& work) {
 // Parses a config from YAML text (dicts arrive as JSON, a YAML subset); UserError -> ValueError.
 Config config_from_text(const std::string& text, const std::string& source);
 
+// Read-only views of a compiled MuJoCo model and of an env's mjData (env.cc's `Model` and `Data`
+// classes), for any env that has them; `owner` keeps the memory alive while a view or an array
+// taken from it lives.
+py::object model_view(std::shared_ptr<const void> owner, const mjModel* model);
+py::object data_view(std::shared_ptr<const void> owner, const mjModel* model, const mjData* data);
+// A SaMI env's views (sami.cc's `SamiModel` and `SamiData`: this episode's hidden parameters
+// included) and its info dict (steps, the task set, the hidden parameters and labels).
+py::object sami_model_view(std::shared_ptr<sami::SamiEnv> env);
+py::object sami_data_view(std::shared_ptr<sami::SamiEnv> env);
+py::dict sami_info(const sami::SamiEnv& env);
+
 void bind_env(py::module_& m);
 void bind_learn(py::module_& m);
 void bind_tma(py::module_& m);
 void bind_sami(py::module_& m);
 void bind_teach(py::module_& m);
+void bind_registry(py::module_& m);    // registry.cc, after bind_env and bind_sami (their views)
 void bind_sami_learn(py::module_& m);  // sami_learn.cc, called by bind_sami
 
 }  // namespace cradle::python

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -63,19 +64,23 @@ Named named(const mjModel* m, mjtObj type, int n, const IdOrName& ref, const cha
   return {id, name ? name : ""};
 }
 
-// env.model: the compiled mjModel, shared by every env of a config.
+// env.model: a compiled mjModel (a BabyBench config's, shared by its envs; a MIMo sample env's),
+// kept alive by `holder`.
 struct ModelView {
-  std::shared_ptr<const envs::BabyBenchAssets> assets;
-  const mjModel* m() const { return assets->model.get(); }
-  py::capsule owner() const { return keep_alive(assets); }
+  std::shared_ptr<const void> holder;
+  const mjModel* model = nullptr;
+  const mjModel* m() const { return model; }
+  py::capsule owner() const { return keep_alive(holder); }
 };
 
-// env.data: the env's own mjData (read-only from Python).
+// env.data: an env's own mjData (read-only from Python), kept alive by `holder`.
 struct DataView {
-  std::shared_ptr<const envs::BabyBenchEnv> env;
-  const mjModel* m() const { return env->model(); }
-  const mjData* d() const { return env->data(); }
-  py::capsule owner() const { return keep_alive(env); }
+  std::shared_ptr<const void> holder;
+  const mjModel* model = nullptr;
+  const mjData* data = nullptr;
+  const mjModel* m() const { return model; }
+  const mjData* d() const { return data; }
+  py::capsule owner() const { return keep_alive(holder); }
 };
 
 // env.proprioception.
@@ -216,6 +221,14 @@ class PyEnv {
   std::unique_ptr<senses::CameraRenderer> renderer_;
   int renderer_width_ = 0, renderer_height_ = 0;
 };
+
+py::object model_view(std::shared_ptr<const void> owner, const mjModel* model) {
+  return py::cast(ModelView{std::move(owner), model});
+}
+
+py::object data_view(std::shared_ptr<const void> owner, const mjModel* model, const mjData* data) {
+  return py::cast(DataView{std::move(owner), model, data});
+}
 
 void bind_env(py::module_& m) {
   py::class_<Named>(m, "Named", "A named MuJoCo object: its id and name.")
@@ -413,8 +426,14 @@ void bind_env(py::module_& m) {
       .def_property_readonly(
           "dt",
           [](PyEnv& e) { return e.env().config().frame_skip * e.env().model()->opt.timestep; })
-      .def_property_readonly("model", [](PyEnv& e) { return ModelView{e.assets()}; })
-      .def_property_readonly("data", [](PyEnv& e) { return DataView{e.shared()}; })
+      .def_property_readonly("model",
+                             [](PyEnv& e) {
+                               return ModelView{e.assets(), e.assets()->model.get()};
+                             })
+      .def_property_readonly("data",
+                             [](PyEnv& e) {
+                               return DataView{e.shared(), e.env().model(), e.env().data()};
+                             })
       .def_property_readonly("proprioception", [](PyEnv& e) { return ProprioView{e.shared()}; })
       .def_property_readonly("touch", [](PyEnv& e) -> py::object {
         if (!e.env().touch()) return py::none();

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "envs/babybench.h"
+#include "envs/registry.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
 #include "learn/vector_env.h"
@@ -42,8 +43,9 @@ py::array object_array(std::vector<py::object> items) {
 
 }  // namespace
 
-// N BabyBench envs stepped by C++ threads (or worker processes), with batched numpy observations.
-// Next-step autoreset (Gymnasium 1.x's default) or, with same_step, Stable-Baselines3's
+// N envs stepped by C++ threads (or, BabyBench, worker processes), with batched numpy
+// observations: a BabyBench config's envs, or any registry id's (envs/registry.h). Next-step
+// autoreset (Gymnasium 1.x's default) or, with same_step, Stable-Baselines3's
 // convention: an env whose episode ends is reset in the same call, its last observation and info
 // kept in the infos as "final_obs" / "final_info".
 class PyVecEnv {
@@ -67,6 +69,30 @@ class PyVecEnv {
       }
     }
     entries_ = entries_of(vec_->observation_space());
+  }
+
+  // The envs of a registry id: env i made by the id's factory with index i and seed
+  // ThreadedVecEnv::env_seed(seed, i), all sharing what the factory compiled once.
+  PyVecEnv(const std::string& id, int num_envs, int threads, std::uint64_t seed, bool same_step,
+           const envs::EnvOptions& options)
+      : same_step_(same_step) {
+    if (num_envs < 1) throw py::value_error("num_envs must be at least 1");
+    {
+      py::gil_scoped_release release;
+      const envs::EnvMaker maker = envs::env_maker(id, options);
+      auto vec = std::make_unique<learn::ThreadedVecEnv>(
+          num_envs, [&](int i) { return maker(i, learn::ThreadedVecEnv::env_seed(seed, i)); },
+          threads);
+      threaded_ = vec.get();
+      vec_ = std::move(vec);
+    }
+    entries_ = entries_of(vec_->observation_space());
+  }
+
+  // Reset options (a teacher's task parameters) for every env's following resets.
+  void set_reset_options(const envs::ResetOptions& options) {
+    if (!threaded_) throw UserError("reset options are not supported with worker processes");
+    for (int i = 0; i < num_envs(); ++i) vec_->env(i).set_reset_options(options);
   }
 
   int num_envs() const { return vec_->num_envs(); }
@@ -351,10 +377,20 @@ struct PyPolicy {
 
 void bind_learn(py::module_& m) {
   py::class_<PyVecEnv>(m, "VecEnv",
-                       "BabyBench envs stepped by C++ threads or processes (use cradle.VectorEnv).")
+                       "Envs stepped by C++ threads or processes (use cradle.VectorEnv).")
       .def(py::init<const Config&, int, int, bool, std::uint64_t, bool, int>(), py::arg("config"),
            py::arg("num_envs"), py::arg("threads") = 0, py::arg("training") = false,
            py::arg("seed") = 0, py::arg("same_step") = false, py::arg("procs") = 0)
+      .def_static(
+          "for_id",
+          [](const std::string& id, int num_envs, int threads, std::uint64_t seed, bool same_step,
+             const envs::EnvOptions& options) {
+            return std::make_unique<PyVecEnv>(id, num_envs, threads, seed, same_step, options);
+          },
+          py::arg("id"), py::arg("num_envs"), py::arg("threads") = 0, py::arg("seed") = 0,
+          py::arg("same_step") = false, py::arg("options") = envs::EnvOptions{},
+          "The envs of a registry id (env i: index i, seed env_seed(seed, i)).")
+      .def("set_reset_options", &PyVecEnv::set_reset_options, py::arg("options"))
       .def("reset", &PyVecEnv::reset, py::arg("seed"))
       .def("step", &PyVecEnv::step, py::arg("actions"))
       .def("bench", &PyVecEnv::bench, py::arg("actions"))
@@ -369,6 +405,9 @@ void bind_learn(py::module_& m) {
                              [](PyVecEnv& v) { return space_list(v.vec().observation_space()); })
       .def_property_readonly("action_space",
                              [](PyVecEnv& v) { return box_tuple(v.vec().action_space()); });
+
+  m.def("env_seed", &learn::ThreadedVecEnv::env_seed, py::arg("seed"), py::arg("index"),
+        "The seed of env `index` of a vector seeded with `seed` (its reset(seed) and make).");
 
   m.def(
       "train",

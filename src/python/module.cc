@@ -155,4 +155,5 @@ PYBIND11_MODULE(_cradle, m) {
   cradle::python::bind_tma(m);
   cradle::python::bind_sami(m);
   cradle::python::bind_teach(m);
+  cradle::python::bind_registry(m);
 }

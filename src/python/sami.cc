@@ -177,6 +177,16 @@ py::dict info(const sami::SamiEnv& env) {
 
 }  // namespace
 
+py::object sami_model_view(std::shared_ptr<sami::SamiEnv> env) {
+  return py::cast(SamiModelView{std::move(env)});
+}
+
+py::object sami_data_view(std::shared_ptr<sami::SamiEnv> env) {
+  return py::cast(SamiDataView{std::move(env)});
+}
+
+py::dict sami_info(const sami::SamiEnv& env) { return info(env); }
+
 void bind_sami(py::module_& m) {
   bind_sami_learn(m);
   bind_views(m);
