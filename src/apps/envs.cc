@@ -95,7 +95,8 @@ void register_envs(CLI::App& app) {
         continue;
       }
       std::string params;
-      for (const envs::TaskParameter& p : s.parameters) params += (params.empty() ? "" : ",") + p.name;
+      for (const envs::TaskParameter& p : s.parameters)
+        params += (params.empty() ? "" : ",") + p.name;
       std::printf("%-40s %-9s %6d  %s\n", s.id.c_str(), s.family.c_str(), s.max_episode_steps,
                   params.empty() ? "-" : params.c_str());
     }

@@ -89,6 +89,8 @@ void register_train(CLI::App& app) {
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--seed", opts->train.seed, "Seed of everything")->check(kSeed);
   cmd->add_flag("--resume", opts->train.resume, "Continue from <save_dir>/checkpoints/latest.ckpt");
+  cmd->add_flag("--overwrite", opts->train.overwrite,
+                "Replace the run already in the folder (its checkpoints, logs and plots)");
   cmd->add_flag("--randomize-start", opts->train.randomize_start,
                 "Random start postures within joint limits");
   cmd->add_option("--checkpoint-every", opts->train.checkpoint_every,

@@ -63,7 +63,8 @@ std::string mimo_short_name(std::string_view registered) {
 std::vector<TaskParameter> sami_parameters(sami::EnvId id) {
   const sami::Varies v = sami::env_varies(id);
   std::vector<TaskParameter> out;
-  if (v.mass) out.push_back({"mass", SamiEnvAdapter::kFactorRange[0], SamiEnvAdapter::kFactorRange[1]});
+  if (v.mass)
+    out.push_back({"mass", SamiEnvAdapter::kFactorRange[0], SamiEnvAdapter::kFactorRange[1]});
   if (v.damping)
     out.push_back({"damping", SamiEnvAdapter::kFactorRange[0], SamiEnvAdapter::kFactorRange[1]});
   if (v.cells) {
@@ -210,7 +211,8 @@ EnvMaker mimo_maker(const std::string& registered, const EnvOptions& options) {
                         "' (expected spring_damper or muscle)");
       }
     } else {
-      throw UserError("env option '" + name + "' is not one MIMo sample envs take (expected "
+      throw UserError("env option '" + name +
+                      "' is not one MIMo sample envs take (expected "
                       "actuation)");
     }
   }
@@ -244,7 +246,8 @@ EnvMaker sami_maker(const ParsedId& p, const EnvOptions& options) {
   sami::Options so;
   for (const auto& [name, value] : options) {
     if (name != "contact_forces")
-      throw UserError("env option '" + name + "' is not one SaMI envs take (expected "
+      throw UserError("env option '" + name +
+                      "' is not one SaMI envs take (expected "
                       "contact_forces)");
     if (value != "0" && value != "1" && value != "true" && value != "false")
       throw UserError("env option contact_forces = '" + value + "' (expected true or false)");
@@ -257,7 +260,8 @@ EnvMaker sami_maker(const ParsedId& p, const EnvOptions& options) {
   return [id, all, each, model, so](int index, std::uint64_t seed) -> std::unique_ptr<Env> {
     std::vector<sami::TaskSet> sets =
         index < 0 ? all : std::vector<sami::TaskSet>{each[index % each.size()]};
-    auto env = std::make_unique<SamiEnvAdapter>(sami::make_env(id, std::move(sets), seed, model, so));
+    auto env =
+        std::make_unique<SamiEnvAdapter>(sami::make_env(id, std::move(sets), seed, model, so));
     env->reset(seed);
     return env;
   };

@@ -27,9 +27,9 @@
 namespace cradle::envs {
 
 struct EnvSpec {
-  std::string id;       // "mimo/reach", "tma/parkour:fish", "sami/CrippleAnt:moderate", ...
-  std::string family;   // "babybench", "mimo", "tma" or "sami"
-  std::string summary;  // one line, for listings
+  std::string id;             // "mimo/reach", "tma/parkour:fish", "sami/CrippleAnt:moderate", ...
+  std::string family;         // "babybench", "mimo", "tma" or "sami"
+  std::string summary;        // one line, for listings
   int max_episode_steps = 0;  // truncation (0: none)
   std::vector<TaskParameter> parameters;
   std::vector<std::string> aliases;  // other names of the same env (the reference's)

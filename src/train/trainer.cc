@@ -26,8 +26,8 @@
 #include "learn/vector_env.h"
 #include "train/babybench_vector.h"
 #include "train/curriculum_env.h"
-#include "train/loop.h"
 #include "train/env_vector.h"
+#include "train/loop.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -135,6 +135,11 @@ bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& sc
 
 }  // namespace
 
+namespace {
+// This process's rank in a data-parallel run (0 when alone).
+int rank_of(learn::GradSync* sync) { return distributed(sync) ? sync->rank() : 0; }
+}  // namespace
+
 std::string registered_env_id(const std::string& name) {
   // `cradle illustrate`'s short names of the MIMo sample tasks.
   for (const char* short_name : {"reach", "standup", "selfbody", "catch"})
@@ -176,6 +181,25 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   const fs::path latest = checkpoints / "latest.ckpt";
   if (options.resume && !fs::exists(latest)) {
     throw UserError("--resume: no checkpoint at '" + latest.string() + "'");
+  }
+  // A folder that holds a run is never replaced silently: --resume continues it, --overwrite
+  // replaces it (its checkpoints, logs and plots go first), anything else is refused.
+  if (!options.resume) {
+    std::error_code ec;
+    const fs::path progress = dir / "logs" / "progress.csv";
+    const bool holds_run = fs::exists(latest, ec) || fs::exists(progress, ec);
+    if (holds_run && !options.overwrite) {
+      throw UserError("'" + dir.string() + "' holds a run (" +
+                      (fs::exists(latest, ec) ? latest : progress).string() +
+                      "): give --resume to continue it, --overwrite to replace it, or another "
+                      "--save-dir");
+    }
+    if (holds_run && rank_of(options.sync.get()) == 0) {
+      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
+        fs::remove_all(dir / sub, ec);
+        if (ec) throw UserError("--overwrite: cannot remove '" + (dir / sub).string() + "'");
+      }
+    }
   }
 
   // A resumed run keeps its algorithm; --hp values override the checkpoint's (those that fix
@@ -413,9 +437,9 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     rows.push_back(std::move(row));
 
     // Only BabyBench scores behaviour.
-    bar.show(s.steps, elapsed,
-             "return " + csv_cell(s.episodic_return) +
-                 (by_id ? "" : "  score " + csv_cell(last_score)));
+    bar.show(
+        s.steps, elapsed,
+        "return " + csv_cell(s.episodic_return) + (by_id ? "" : "  score " + csv_cell(last_score)));
     return true;
   };
   // Learning stops at each checkpoint (an episode boundary) and continues in a new learn() call.

@@ -44,6 +44,9 @@ struct TrainOptions {
   // Continue from <save_dir>/checkpoints/latest.ckpt: its hyperparameters, with `hyperparameters`
   // applied over them; the logs are cut back to what the checkpoint knows.
   bool resume = false;
+  // Replace a run already in <save_dir> (its checkpoints, logs and plots are removed first);
+  // without it (or resume) a folder that holds a run is refused.
+  bool overwrite = false;
   bool randomize_start = false;  // random start postures within joint limits
   long checkpoint_every = 100000;
   std::map<std::string, std::string> hyperparameters;  // overrides, by name

@@ -86,7 +86,7 @@ TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
   const std::string config = cradle::test::config_path("config_selftouch.yml").string();
   for (const std::string& args : std::vector<std::string>{
            "train", "train --env fly", "train --env reach --config " + config,
-           "train --env reach --intrinsic body_part_novelty", "train --env reach --randomize-start",
+           "train --env tma/parkour", "train --env reach --randomize-start",
            "train --env reach --compare-random", "train --env reach --eval-episodes 3",
            "train --env reach --teacher Random"}) {
     const RunResult r = run_cradle(args + " --steps 64", dir);
@@ -95,9 +95,32 @@ TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
   }
   EXPECT_FALSE(fs::exists(dir / "results"));  // nothing written
-  // The unknown env names the known ones.
-  EXPECT_NE(run_cradle("train --env fly", dir).out.find("reach, standup, selfbody, catch"),
+  // The unknown env names the closest ids.
+  EXPECT_NE(run_cradle("train --env mimo/rech", dir).out.find("closest: mimo/reach"),
             std::string::npos);
+}
+
+// A folder that holds a run is refused without --resume or --overwrite, whatever the family, and
+// left as it was; --overwrite replaces it.
+TEST(TrainEnv, AFinishedRunIsNeverReplacedSilently) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_overwrite");
+  for (const char* env : {"tma/stump-tracks:old_classic_bipedal", "sami/Hopper"}) {
+    const std::string args =
+        std::string("train --env ") + env +
+        " --algo ppo --envs 1 --steps 64 --hp n_steps=32 --hp batch_size=32 --save-dir run";
+    ASSERT_EQ(run_cradle(args, dir).status, 0) << env;
+    const std::vector<std::string> before = read_lines(dir / "run" / "logs" / "progress.csv");
+    const RunResult again = run_cradle(args + " --seed 9", dir);
+    EXPECT_EQ(again.status, 1) << again.out;
+    EXPECT_EQ(std::count(again.out.begin(), again.out.end(), '\n'), 1) << again.out;
+    EXPECT_NE(again.out.find("--resume"), std::string::npos) << again.out;
+    EXPECT_NE(again.out.find("--overwrite"), std::string::npos) << again.out;
+    EXPECT_EQ(read_lines(dir / "run" / "logs" / "progress.csv"), before);
+    const RunResult replaced = run_cradle(args + " --seed 9 --overwrite", dir);
+    EXPECT_EQ(replaced.status, 0) << replaced.out;
+    EXPECT_NE(read_lines(dir / "run" / "logs" / "progress.csv"), before);
+    fs::remove_all(dir / "run");
+  }
 }
 
 }  // namespace

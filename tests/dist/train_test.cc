@@ -93,10 +93,11 @@ TEST_P(LaunchById, TwoRanksEndWithBitwiseIdenticalParameters) {
   if (algo == "sac")
     hp = " --hp learning_starts=16 batch_size=16 buffer_size=2000 report_every=16 "
          "pi_layers=32,32 qf_layers=32,32";
-  const RunResult r = run_cradle("launch --nproc 2 -- cradle train --env " + env + " --algo " +
-                                 algo + " --envs 1 --threads 1 --steps 128 --checkpoint-every 64 "
-                                 "--seed 5 --dist-timeout 30 --save-dir " +
-                                 (dir / "run").string() + hp);
+  const RunResult r =
+      run_cradle("launch --nproc 2 -- cradle train --env " + env + " --algo " + algo +
+                 " --envs 1 --threads 1 --steps 128 --checkpoint-every 64 "
+                 "--seed 5 --dist-timeout 30 --save-dir " +
+                 (dir / "run").string() + hp);
   ASSERT_EQ(r.status, 0) << r.out;
   const std::map<int, std::string> h = hashes(r.out);
   ASSERT_EQ(h.size(), 2u) << r.out;

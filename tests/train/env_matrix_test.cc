@@ -35,9 +35,8 @@ int progress_rows(const fs::path& csv) {
 // A short run of `algo` on env `id`: a BabyBench id as its config, any other by id.
 train::TrainResult short_run(const std::string& id, const std::string& algo, long steps,
                              const fs::path& dir,
-                             std::map<std::string, std::string> hp = {{"n_steps", "32"},
-                                                                      {"batch_size", "32"},
-                                                                      {"n_epochs", "1"}}) {
+                             std::map<std::string, std::string> hp = {
+                                 {"n_steps", "32"}, {"batch_size", "32"}, {"n_epochs", "1"}}) {
   const envs::EnvSpec spec = envs::env_spec(id);
   Config config;
   train::TrainOptions o{.algorithm = algo, .intrinsic = "", .steps = steps, .envs = 2};
@@ -100,12 +99,11 @@ TEST(EnvMatrix, OffPolicyLearnersTrainOnEveryFamily) {
 TEST(EnvMatrix, SamiLearnersTrainOnSamiAndOnOtherFamilies) {
   const fs::path root = fresh_dir("env_matrix_sami_learners");
   const std::map<std::string, std::string> hp = {
-      {"learning_starts", "100"}, {"train_freq", "50"},   {"gradient_steps", "1"},
+      {"learning_starts", "100"}, {"train_freq", "50"},         {"gradient_steps", "1"},
       {"batch_size", "2"},        {"contrast_batch_size", "2"}, {"net_arch", "32,32"},
-      {"lstm_hidden", "16"},      {"horizon", "100"},      {"report_every", "100"}};
-  for (const auto& [id, algo] :
-       std::vector<std::pair<std::string, std::string>>{{"sami/CrippleHalfCheetah", "saccm"},
-                                                        {"mimo/reach", "tesac"}}) {
+      {"lstm_hidden", "16"},      {"horizon", "100"},           {"report_every", "100"}};
+  for (const auto& [id, algo] : std::vector<std::pair<std::string, std::string>>{
+           {"sami/CrippleHalfCheetah", "saccm"}, {"mimo/reach", "tesac"}}) {
     SCOPED_TRACE(id + " " + algo);
     const fs::path dir = root / algo;
     const train::TrainResult r = short_run(id, algo, 400, dir, hp);
@@ -122,8 +120,8 @@ TEST(EnvMatrix, AlpGmmDrivesSamiMassAndDamping) {
   const fs::path dir = fresh_dir("env_matrix_sami_curriculum");
   Config config;
   config.save_dir = dir.string();
-  train::TrainOptions o{.env = "sami/HalfCheetah", .algorithm = "ppo", .intrinsic = "",
-                        .steps = 4096, .envs = 2};
+  train::TrainOptions o{
+      .env = "sami/HalfCheetah", .algorithm = "ppo", .intrinsic = "", .steps = 4096, .envs = 2};
   o.threads = 2;
   o.eval_episodes = 0;
   o.progress_bar = false;

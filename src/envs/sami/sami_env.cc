@@ -4,7 +4,6 @@
 #include <string>
 
 #include "core/error.h"
-
 #include "envs/action_check.h"
 
 namespace cradle::envs {

@@ -38,7 +38,7 @@ class SamiEnvAdapter final : public Env {
   Box action_space_;
   ObservationBuffers buffers_;
   Info info_;
-  int success_slot_ = -1;  // info "is_success"
+  int success_slot_ = -1;                 // info "is_success"
   std::vector<sami::TaskSet> base_sets_;  // the sets the env was made with
 };
 
