@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "core/error.h"
@@ -80,12 +81,68 @@ const Values kTrainMass = {0.75, 0.85, 1.0, 1.15, 1.25};
 const std::vector<Values> kModerateMass = {{0.4, 0.5}, {1.5, 1.6}};
 const std::vector<Values> kExtremeMass = {{0.2, 0.3}, {1.7, 1.8}};
 
-void check_values(const Values& values, const char* what) {
-  if (values.empty()) throw UserError(std::string(what) + " list is empty; expected >= 1 factor");
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+std::string range_text(const ValueRange& r) {
+  return (r.open_low ? "(" : "[") + number_text(r.low) + ", " + number_text(r.high) + "]";
+}
+
+// `where`: the set's place ("sets.yml: task_sets[0]", "Ant task set 0"); `what`: mass or
+// damping.
+void check_factors(const Values& values, const std::string& where, const std::string& what,
+                   const ValueRange& range) {
+  const std::string expected = "expected " + what + " factors in " + range_text(range);
+  if (values.empty()) throw UserError(where + "." + what + " is an empty list; " + expected);
   for (double v : values) {
-    if (!std::isfinite(v) || v <= 0) {
-      throw UserError(std::string(what) + " factor " + std::to_string(v) +
-                      " is invalid; expected a finite number > 0");
+    if (!range.contains(v)) {
+      throw UserError(where + "." + what + ": " + what + " factor " + number_text(v) +
+                      " is out of range; " + expected);
+    }
+  }
+}
+
+void validate_set(EnvId id, const TaskSet& t, const std::string& where) {
+  const std::string env(env_name(id));
+  const Varies v = env_varies(id);
+  if (!v.mass && t.mass != Values{1.0}) throw UserError(where + ": " + env + " does not vary mass");
+  if (!v.damping && t.damping != Values{1.0}) {
+    throw UserError(where + ": " + env + " does not vary damping");
+  }
+  check_factors(t.mass, where, "mass", kMassFactors);
+  check_factors(t.damping, where, "damping", kDampingFactors);
+  if (!v.cells && !t.cells.empty()) {
+    throw UserError(where + ": " + env + " has no friction x mass cells");
+  }
+  if (v.cells && t.cells.empty()) {
+    throw UserError(where + ": " + env +
+                    " has no cells in this task set; expected cells: [[friction, mass], ...]");
+  }
+  for (const auto& [f, m] : t.cells) {
+    if (!kTableFriction.contains(f) || !kCubeMass.contains(m)) {
+      throw UserError(where + ".cells: cell [" + number_text(f) + ", " + number_text(m) +
+                      "] is out of range; expected table friction in " +
+                      range_text(kTableFriction) + " and cube mass in " + range_text(kCubeMass) +
+                      " kg");
+    }
+  }
+  if (v.cripple_units == 0 && !t.cripple.empty()) {
+    throw UserError(where + ": " + env + " cannot be crippled");
+  }
+  for (const auto& choice : t.cripple) {
+    const std::set<int> unique(choice.begin(), choice.end());
+    if (unique.size() != choice.size() || static_cast<int>(choice.size()) > v.max_crippled) {
+      throw UserError(where + ".cripple: " + env + "'s cripple choice must list at most " +
+                      std::to_string(v.max_crippled) + " distinct joints");
+    }
+    for (int u : choice) {
+      if (u < 0 || u >= v.cripple_units) {
+        throw UserError(where + ".cripple: " + env + "'s cripple index " + std::to_string(u) +
+                        " is out of range; expected 0.." + std::to_string(v.cripple_units - 1));
+      }
     }
   }
 }
@@ -251,49 +308,34 @@ std::vector<TaskSet> split_sets(EnvId id, Split split) {
 void validate(EnvId id, const std::vector<TaskSet>& sets) {
   const std::string env(env_name(id));
   if (sets.empty()) throw UserError(env + ": no task sets; expected at least one");
-  const Varies v = env_varies(id);
-  for (const TaskSet& t : sets) {
-    check_values(t.mass, "mass");
-    check_values(t.damping, "damping");
-    if (!v.mass && t.mass != Values{1.0}) throw UserError(env + " does not vary mass");
-    if (!v.damping && t.damping != Values{1.0}) throw UserError(env + " does not vary damping");
-    if (!v.cells && !t.cells.empty()) throw UserError(env + " has no friction x mass cells");
-    if (v.cells && t.cells.empty()) {
-      throw UserError(env + ": a task set has no cells; expected [[friction, mass], ...]");
-    }
-    for (const auto& [f, m] : t.cells) {
-      if (!std::isfinite(f) || f < 0 || !std::isfinite(m) || m <= 0) {
-        throw UserError(env + ": cell (" + std::to_string(f) + ", " + std::to_string(m) +
-                        ") is invalid; expected friction >= 0 and mass > 0");
-      }
-    }
-    if (v.cripple_units == 0 && !t.cripple.empty()) throw UserError(env + " cannot be crippled");
-    for (const auto& choice : t.cripple) {
-      const std::set<int> unique(choice.begin(), choice.end());
-      if (unique.size() != choice.size() || static_cast<int>(choice.size()) > v.max_crippled) {
-        throw UserError(env + ": a cripple choice must list at most " +
-                        std::to_string(v.max_crippled) + " distinct joints");
-      }
-      for (int u : choice) {
-        if (u < 0 || u >= v.cripple_units) {
-          throw UserError(env + ": cripple index " + std::to_string(u) + " is out of range; " +
-                          "expected 0.." + std::to_string(v.cripple_units - 1));
-        }
-      }
-    }
+  for (size_t i = 0; i < sets.size(); ++i) {
+    validate_set(id, sets[i], env + " task set " + std::to_string(i));
   }
 }
 
 std::vector<TaskSet> load_task_sets(EnvId id, const std::filesystem::path& file) {
+  const std::string name = file.string();
+  // A folder or a special file would reach yaml-cpp's stream as an internal read error.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(file, ec);
+  if (!std::filesystem::exists(status)) {
+    throw UserError("task-set file '" + name + "' does not exist; expected a .yml file");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    throw UserError("task-set file '" + name + "' is " +
+                    (std::filesystem::is_directory(status) ? "a folder" : "not a regular file") +
+                    "; expected a .yml file");
+  }
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
+    root = YAML::LoadFile(name);
   } catch (const YAML::BadFile&) {
-    throw UserError("cannot read task-set file '" + file.string() + "'");
+    throw UserError("cannot read task-set file '" + name + "'");
   } catch (const YAML::Exception& e) {
-    throw UserError("task-set file '" + file.string() + "' is not valid YAML: " + e.msg);
+    throw UserError("task-set file '" + name + "' is not valid YAML: " + e.msg);
+  } catch (const std::exception& e) {  // an I/O error while reading
+    throw UserError("cannot read task-set file '" + name + "': " + e.what());
   }
-  const std::string name = file.string();
   if (!root.IsMap() || !root["task_sets"] || !root["task_sets"].IsSequence()) {
     throw UserError(name + ": expected a top-level key task_sets with a list of task sets");
   }
@@ -303,9 +345,11 @@ std::vector<TaskSet> load_task_sets(EnvId id, const std::filesystem::path& file)
     const std::string where = name + ": task_sets[" + std::to_string(index++) + "]";
     if (!node.IsMap()) throw UserError(where + " is not a map");
     TaskSet t;
+    std::set<std::string> keys;
     for (const auto& kv : node) {
       const std::string key = read<std::string>(kv.first, where + " key", "a string");
       const std::string at = where + "." + key;
+      if (!keys.insert(key).second) throw UserError(at + " is given twice; expected each key once");
       if (key == "mass") {
         t.mass = read<Values>(kv.second, at, "a list of numbers");
       } else if (key == "damping") {
@@ -324,9 +368,12 @@ std::vector<TaskSet> load_task_sets(EnvId id, const std::filesystem::path& file)
                         "cells");
       }
     }
+    validate_set(id, t, where);
     sets.push_back(std::move(t));
   }
-  validate(id, sets);
+  if (sets.empty()) {
+    throw UserError(name + ": task_sets is an empty list; expected at least one task set");
+  }
   return sets;
 }
 

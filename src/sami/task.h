@@ -53,6 +53,19 @@ struct TaskSet {
   std::vector<std::array<double, 2>> cells;
 };
 
+// The plausible range of a task set's value: [low, high], or (low, high] when open_low. Beyond
+// them MuJoCo's integrators diverge (damping x5 makes the humanoids' states NaN) or the task is
+// no physical one (a mass x1e-300); validate() refuses values outside them.
+struct ValueRange {
+  double low, high;
+  bool open_low = false;
+  bool contains(double v) const { return (open_low ? v > low : v >= low) && v <= high; }  // NaN: no
+};
+inline constexpr ValueRange kMassFactors{0.01, 100};
+inline constexpr ValueRange kDampingFactors{0, 3, true};
+inline constexpr ValueRange kTableFriction{0, 100};  // Panda
+inline constexpr ValueRange kCubeMass{0.01, 100};    // Panda, kg
+
 enum class Split { kTrain, kModerate, kExtreme };
 std::string_view split_name(Split split);
 // Throws UserError for a name other than train / moderate / extreme.
@@ -63,9 +76,13 @@ std::vector<TaskSet> split_sets(EnvId id, Split split);
 // The split a name selects, or the task sets of a YAML file when `name` ends in .yml / .yaml.
 std::vector<TaskSet> task_sets(EnvId id, std::string_view split_or_file);
 // Task sets from a YAML file: `task_sets: [{mass: [..], damping: [..], cripple: [[..]], mask: b,
-// cells: [[friction, mass]]}]`. Throws UserError for anything wrong.
+// cells: [[friction, mass]]}]`. Throws UserError naming the file and the set for anything wrong
+// (a missing file or a folder, bad YAML, an unknown or repeated key, what validate() refuses).
 std::vector<TaskSet> load_task_sets(EnvId id, const std::filesystem::path& file);
-// Throws UserError if a set asks for something the env does not vary or holds a bad value.
+// Throws UserError if a set asks for something the env does not vary or holds a value out of its
+// plausible range (kMassFactors [0.01, 100], kDampingFactors (0, 3], Panda's kTableFriction
+// [0, 100] and kCubeMass [0.01, 100] kg); no list of factors or cells may be empty, and NaN or
+// infinity is never in range.
 void validate(EnvId id, const std::vector<TaskSet>& sets);
 
 // A crippling choice as text: its joints (Ant: legs) joined by `separator`, e.g. "0,4".
