@@ -17,7 +17,7 @@ set(floor_senses core model sim)
 set(floor_envs core model scene senses sim tma sami)
 # The env families below envs/ (their own rooms).
 set(floor_tma core)
-set(floor_sami core senses)
+set(floor_sami core sim senses)
 set(floor_eval core model envs)
 set(floor_learn core envs)
 set(floor_teach core envs)

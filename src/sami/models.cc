@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/xml.h"
+#include "sim/mujoco_handlers.h"
 
 namespace cradle::sami {
 namespace {
@@ -674,6 +675,10 @@ std::string robot_xml(Robot robot) {
 }
 
 ModelPtr compile_xml(std::string_view xml) {
+  // Every SaMI model is compiled here, so MuJoCo's warnings (e.g. "Nan, Inf or huge value in
+  // QACC") go to stderr as one line from the first SaMI env on, never onto stdout, and its fatal
+  // errors are UserErrors (sim/mujoco_handlers.h).
+  sim::install_mujoco_handlers();
   // mjVFS holds fixed-size name tables (megabytes): keep it off the stack.
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
