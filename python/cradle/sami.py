@@ -182,14 +182,19 @@ def make(name, split="train", seed=0, **kwargs):
 METHODS = ("TESAC", "CCM", "SaTESAC", "SaCCM", "SaCCMAll")
 
 
-def train(env="PandaPush", method="SaCCM", seed=0, steps_per_env=0, hyperparameters=None,
+def train(env=None, method=None, seed=0, steps_per_env=0, hyperparameters=None,
           out="", resume=False, checkpoint_every=100_000, progress_bar=False):
     """`cradle sami train` from Python: trains a SaMI method on the env's training task sets.
 
-    steps_per_env=0 takes SaMI's budget (500k per env; PandaPush 1M). hyperparameters: a dict of
-    overrides ({"batch_size": 32}). Returns a dict: run, steps, updates, sps,
-    gradient_steps_per_s, last_return, checkpoint. Bad inputs raise ValueError (one line).
+    env and method default to PandaPush and SaCCM; resume=True with out continues that run's env
+    and method (an env or method given must be the run's, else ValueError). steps_per_env=0 takes
+    SaMI's budget (500k per env; PandaPush 1M). hyperparameters: a dict of overrides
+    ({"batch_size": 32}). Returns a dict: run, steps, updates, sps, gradient_steps_per_s,
+    last_return, checkpoint. Bad inputs raise ValueError (one line).
     """
+    continues = bool(resume) and bool(str(out))
+    env = ("" if continues else "PandaPush") if env is None else env
+    method = ("" if continues else "SaCCM") if method is None else method
     hp = {str(k): str(v).lower() if isinstance(v, bool) else
           ",".join(str(x) for x in v) if isinstance(v, (list, tuple)) else str(v)
           for k, v in (hyperparameters or {}).items()}

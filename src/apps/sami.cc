@@ -187,7 +187,23 @@ void register_learners(CLI::App& cmd) {
                  "Env steps per training env between checkpoints")
       ->check(CLI::Range(1L, 10'000'000'000L));
   tr->add_flag("!--no-progress", opts->train.progress_bar, "No progress bar");
-  tr->callback([opts] {
+  tr->callback([opts, tr] {
+    // --resume --out DIR continues DIR's env, method and seed (its run.json): one left out is the
+    // run's, one given must be the run's (sami_train refuses another env or method, the seed is
+    // checked here). Without --out, they name the folder runs/sami/<env>_<method>_<seed>.
+    if (opts->train.resume && !opts->out.empty()) {
+      if (tr->get_option("--env")->count() == 0) opts->train.env.clear();
+      if (tr->get_option("--method")->count() == 0) opts->train.method.clear();
+      if (tr->get_option("--seed")->count() > 0) {
+        const std::filesystem::path run = opts->out;
+        const std::uint64_t saved = train::read_sami_run(run).seed;
+        if (saved != opts->train.seed) {
+          throw UserError("sami train --resume: " + (run / "run.json").string() +
+                          " is a run of --seed " + std::to_string(saved) + ", not --seed " +
+                          std::to_string(opts->train.seed) + " (leave --seed out to continue it)");
+        }
+      }
+    }
     opts->train.hyperparameters = parse_hp(opts->hp);
     opts->train.out = opts->out;
     opts->train.stop = stop_on({SIGINT, SIGTERM});

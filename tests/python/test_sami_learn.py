@@ -32,5 +32,25 @@ def test_bad_inputs_are_value_errors(tmp_path):
     with pytest.raises(ValueError, match="neg_ratio"):
         cradle.sami.train("PandaPush", "SaCCM", hyperparameters={"neg_ratio": 2},
                           out=str(tmp_path / "b"))
-    with pytest.raises(ValueError):
+    # A missing run folder is a missing file (the module's FileNotFoundError), naming run.json.
+    with pytest.raises(FileNotFoundError, match="missing/run.json does not exist"):
         cradle.sami.evaluate(str(tmp_path / "missing"))
+
+
+def test_resume_keeps_the_runs_env_and_method_and_bad_run_json_names_the_key(tmp_path):
+    run = tmp_path / "run"
+    cradle.sami.train("PandaPush", "CCM", seed=3, steps_per_env=60, hyperparameters=TINY,
+                      out=str(run))
+    before = sorted(os.listdir(run))
+    with pytest.raises(ValueError, match="is a run of --env PandaPush, not --env CrippleAnt"):
+        cradle.sami.train("CrippleAnt", out=str(run), resume=True, steps_per_env=70)
+    with pytest.raises(ValueError, match="is a run of --method CCM, not --method SaCCM"):
+        cradle.sami.train(method="SaCCM", out=str(run), resume=True, steps_per_env=70)
+    assert sorted(os.listdir(run)) == before
+    # Left out, env and method are the run's.
+    r = cradle.sami.train(out=str(run), resume=True, steps_per_env=70, hyperparameters=TINY)
+    assert r["steps"] == 70 * 6
+    text = (run / "run.json").read_text()
+    (run / "run.json").write_text(text.replace('"seed": 3', '"seed": "x"'))
+    with pytest.raises(ValueError, match='run.json: "seed" is "x"; expected an integer'):
+        cradle.sami.evaluate(str(run), episodes=1)

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "train/sami/sami_json.h"
 #include "train/sami/sami_train.h"
 
 namespace cradle::train {
@@ -84,22 +85,32 @@ std::string sami_table(const std::vector<std::filesystem::path>& runs,
   // env -> method -> split -> per-seed scores.
   std::map<std::string, std::map<std::string, std::map<std::string, std::vector<double>>>> scores;
   const std::vector<std::string> splits = {"train", "moderate", "extreme"};
+  // The same folder twice (or by two paths) would count one run as two seeds.
+  std::map<std::filesystem::path, std::filesystem::path> seen;  // canonical -> as given
+  for (const std::filesystem::path& run : runs) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(run, ec)) {
+      throw UserError("sami table: " + run.string() +
+                      " is not a folder; expected the run folder of `cradle sami train`");
+    }
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(run, ec);
+    if (ec) throw UserError("sami table: cannot resolve " + run.string() + ": " + ec.message());
+    const auto [it, fresh] = seen.emplace(canonical, run);
+    if (!fresh) {
+      throw UserError("sami table: " + run.string() + " is the run folder " + it->second.string() +
+                      " given again; expected each run once (one seed each)");
+    }
+  }
   for (const std::filesystem::path& run : runs) {
     bool any = false;
     for (const std::string& split : splits) {
       const std::filesystem::path file = run / ("eval_" + split + ".json");
-      if (!std::filesystem::exists(file)) continue;
-      std::ifstream in(file);
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(in);
-      } catch (const std::exception&) {
-        throw UserError("sami table: " + file.string() + " is not valid JSON");
-      }
-      const std::string env = j.at("env");
-      const double score = env == "PandaPush" ? j.at("success_rate").get<double>()
-                                              : j.at("mean_return").get<double>();
-      scores[env][j.at("method")][split].push_back(score);
+      std::error_code ec;
+      if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) continue;
+      const SamiJson j(file, "the eval_" + split + ".json of `cradle sami evaluate`");
+      const std::string env = j.string("env");
+      const double score = env == "PandaPush" ? j.number("success_rate") : j.number("mean_return");
+      scores[env][j.string("method")][split].push_back(score);
       any = true;
     }
     if (!any) {

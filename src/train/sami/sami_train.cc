@@ -21,6 +21,7 @@
 #include "sami/render.h"
 #include "sami/task.h"
 #include "sami/vector.h"
+#include "train/sami/sami_json.h"
 
 namespace cradle::train {
 namespace {
@@ -51,16 +52,6 @@ SamiConfig make_config(sami::EnvId id, const std::map<std::string, std::string>&
   SamiConfig config;
   text = learn::meta::apply_sami_hyperparameters(config, all);
   return config;
-}
-
-nlohmann::json read_json(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw UserError("sami: cannot read " + file.string());
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    throw UserError("sami: " + file.string() + " is not valid JSON");
-  }
 }
 
 void write_text(const std::filesystem::path& file, const std::string& text) {
@@ -120,8 +111,28 @@ std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id) {
   return out.empty() ? sets : out;
 }
 
+SamiRunFile read_sami_run(const std::filesystem::path& run) {
+  const SamiJson j(run / "run.json", "the run.json of a `cradle sami train` run");
+  SamiRunFile r{.env = j.string("env"),
+                .method = j.string("method"),
+                .seed = j.unsigned_integer("seed"),
+                .steps_per_env = j.positive_integer("steps_per_env"),
+                .hyperparameters = j.string_map("hyperparameters")};
+  // An unknown env or method names the file it came from.
+  try {
+    sami::env_from_name(r.env);
+    learn::meta::method_contrast(r.method);
+  } catch (const UserError& e) {
+    throw UserError(j.file().string() + ": " + e.what());
+  }
+  return r;
+}
+
 SamiTrainResult sami_train(const SamiTrainOptions& options) {
   // The run's settings: fresh from the options, or on --resume from run.json.
+  if (options.out.empty() && (options.env.empty() || options.method.empty())) {
+    throw UserError("sami train: give the run folder (--out) or the env and the method");
+  }
   const std::filesystem::path run =
       options.out.empty()
           ? std::filesystem::path("runs/sami") /
@@ -132,12 +143,23 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   long steps_per_env = options.steps_per_env;
   std::map<std::string, std::string> hp = options.hyperparameters;
   if (options.resume) {
-    const nlohmann::json saved = read_json(run / "run.json");
-    env_name = saved.at("env");
-    method = saved.at("method");
-    seed = saved.at("seed");
-    if (steps_per_env == 0) steps_per_env = saved.at("steps_per_env");
-    std::map<std::string, std::string> merged = saved.at("hyperparameters");
+    const SamiRunFile saved = read_sami_run(run);
+    // A resumed run keeps its env and method: one given that contradicts them is refused, not
+    // ignored.
+    const auto keep = [&](const std::string& given, const std::string& kept, const char* flag) {
+      if (!given.empty() && given != kept) {
+        throw UserError("sami train --resume: " + (run / "run.json").string() + " is a run of " +
+                        flag + " " + kept + ", not " + flag + " " + given + " (leave " + flag +
+                        " out to continue it)");
+      }
+    };
+    keep(options.env, saved.env, "--env");
+    keep(options.method, saved.method, "--method");
+    env_name = saved.env;
+    method = saved.method;
+    seed = saved.seed;
+    if (steps_per_env == 0) steps_per_env = saved.steps_per_env;
+    std::map<std::string, std::string> merged = saved.hyperparameters;
     for (const auto& [k, v] : hp) merged[k] = v;
     hp = merged;
   } else if (std::filesystem::exists(run / "checkpoint.ckpt")) {
@@ -353,13 +375,13 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
 }
 
 SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
-  const nlohmann::json saved = read_json(options.run / "run.json");
-  const sami::EnvId id = sami::env_from_name(saved.at("env").get<std::string>());
-  const std::string method = saved.at("method");
+  const SamiRunFile saved = read_sami_run(options.run);
+  const sami::EnvId id = sami::env_from_name(saved.env);
+  const std::string method = saved.method;
   const sami::Split split = sami::split_from_name(options.split);
   if (options.episodes < 1) throw UserError("sami evaluate: --episodes must be positive");
   std::string text;
-  const SamiConfig config = make_config(id, saved.at("hyperparameters"), text);
+  const SamiConfig config = make_config(id, saved.hyperparameters, text);
   const sami::Spec spec = sami::env_spec(id);
   ContextSac learner(method, spec.obs_size, spec.action_size, config, 0);
   learner.load(options.run / "checkpoint.ckpt");
@@ -489,9 +511,9 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   // Per-cell CSV and JSON.
   std::ostringstream table;
   table << "cell,episodes,success_rate,mean_return,std_return,push,roll,pick_and_place\n";
-  nlohmann::json json{{"env", saved.at("env")},
+  nlohmann::json json{{"env", saved.env},
                       {"method", method},
-                      {"seed", saved.at("seed")},
+                      {"seed", saved.seed},
                       {"split", options.split},
                       {"episodes_per_cell", options.episodes},
                       {"success_rate", result.success_rate},

@@ -23,9 +23,10 @@ namespace cradle::train {
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id);
 
 struct SamiTrainOptions {
+  // On resume, empty takes the run's (run.json); one that differs from the run's is an error.
   std::string env = "PandaPush";
   std::string method = "SaCCM";
-  std::uint64_t seed = 0;
+  std::uint64_t seed = 0;  // on resume the run's (run.json)
   long steps_per_env = 0;  // 0: SaMI's budget (500,000; PandaPush 1,000,000)
   std::map<std::string, std::string> hyperparameters;
   std::filesystem::path out;        // run folder; empty: runs/sami/<env>_<method>_<seed>
@@ -48,6 +49,16 @@ struct SamiTrainResult {
   bool stopped = false;             // ended by `stop` before the budget
 };
 SamiTrainResult sami_train(const SamiTrainOptions& options);
+
+// A run folder's run.json with every key's type checked, and the env and method names known: a
+// missing or bad file, key or value is a one-line UserError naming run.json and the key.
+struct SamiRunFile {
+  std::string env, method;
+  std::uint64_t seed = 0;
+  long steps_per_env = 0;
+  std::map<std::string, std::string> hyperparameters;
+};
+SamiRunFile read_sami_run(const std::filesystem::path& run);
 
 struct SamiEvalOptions {
   std::filesystem::path run;
