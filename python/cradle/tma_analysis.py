@@ -15,6 +15,7 @@ matplotlib (Debian's), so it also runs as a plain script without the compiled ex
 """
 
 import argparse
+import io
 import json
 import math
 import os
@@ -82,6 +83,8 @@ class Run:
     seed: int
     progress: pd.DataFrame
     run_json: dict = field(default_factory=dict)
+    test_returns: pd.DataFrame = None  # None without the file (or rows)
+    test_set: pd.DataFrame = None
 
     @property
     def final(self):
@@ -99,23 +102,99 @@ def _arg(args, key):
     return None
 
 
-def _read_json(path):
+class AnalysisInputError(ValueError):
+    """A results tree the analysis cannot read: one line naming the file and what was expected."""
+
+
+# The columns the analysis reads from each of a run's tables.
+PROGRESS_COLUMNS = ("env_steps", "mean_test_return", MASTERED, "mean_train_return")
+TEST_RETURNS_COLUMNS = ("evaluation", "task_index", "mastered")
+TEST_SET_COLUMNS = ("task_index",)
+
+
+def _read_text(path, expected):
+    """A run file's text; None when it does not exist. A folder, an unreadable file or one that
+    is not UTF-8 text raises AnalysisInputError."""
+    if not os.path.lexists(path):
+        return None
+    if not os.path.isfile(path):
+        kind = "a folder" if os.path.isdir(path) else "not a regular file"
+        raise AnalysisInputError(f"{path} is {kind}; expected {expected}")
     try:
-        with open(path) as f:
-            return json.load(f)
-    except (OSError, ValueError):
+        with open(path, encoding="utf-8") as f:
+            return f.read()
+    except OSError as e:
+        raise AnalysisInputError(
+            f"cannot read {path} ({e.strerror}); expected {expected}") from None
+    except UnicodeDecodeError:
+        raise AnalysisInputError(f"{path} is not text; expected {expected}") from None
+
+
+def _read_json(path):
+    """A run's launch.json / run.json as a dict ({} when it does not exist)."""
+    expected = "a JSON object written by `cradle tma run` or the campaign launcher"
+    text = _read_text(path, expected)
+    if text is None:
         return {}
+    try:
+        value = json.loads(text)
+    except ValueError:
+        raise AnalysisInputError(f"{path} is not valid JSON (cut short or edited?); "
+                                 f"expected {expected}") from None
+    if not isinstance(value, dict):
+        raise AnalysisInputError(f"{path} is not a JSON object; expected {expected}")
+    return value
+
+
+def read_table(path, columns):
+    """A run's CSV table (progress.csv, test_returns.csv, test_set.csv) as a DataFrame: None when
+    the file does not exist or holds no rows yet. Every row must be complete (as many cells as
+    the header, the last line ended) and every cell a number or empty (NaN), and `columns` must
+    be in the header; otherwise AnalysisInputError names the file, the line and the column."""
+    name = os.path.basename(path)
+    expected = f"the {name} of `cradle tma run`"
+    text = _read_text(path, expected)
+    if text is None:
+        return None
+    lines = text.split("\n")
+    if lines[-1] != "":
+        raise AnalysisInputError(f"{path} is truncated: its last line has no end; expected "
+                                 "complete rows (a run still writing it, or a cut copy?)")
+    rows = [(number, line) for number, line in enumerate(lines[:-1], 1) if line.strip()]
+    if len(rows) < 2:
+        return None  # no rows yet (an empty file or the header alone)
+    header = rows[0][1].split(",")
+    missing = [c for c in columns if c not in header]
+    if missing:
+        raise AnalysisInputError(f"{path} has no column {missing[0]}; expected {expected} "
+                                 f"(columns {', '.join(columns)}, ...)")
+    for number, line in rows[1:]:
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise AnalysisInputError(
+                f"{path} line {number} has {len(cells)} cells, the header {len(header)}; "
+                "expected complete rows (cut short or edited?)")
+        for column, cell in zip(header, cells):
+            if cell.strip() == "":
+                continue
+            try:
+                float(cell)
+            except ValueError:
+                raise AnalysisInputError(
+                    f"{path} line {number}, column {column}: {cell!r} is not a number; "
+                    "expected numbers (or empty cells)") from None
+    return pd.read_csv(io.StringIO(text))
 
 
 def load_run(path):
-    """One run folder -> Run (None when it has no progress.csv rows yet)."""
-    progress_file = os.path.join(path, "progress.csv")
-    try:
-        progress = pd.read_csv(progress_file)
-    except (OSError, pd.errors.EmptyDataError):
+    """One run folder -> Run (None when it has no progress.csv rows yet). A progress.csv,
+    test_returns.csv, test_set.csv, run.json or launch.json that is there but unreadable,
+    truncated or not numeric raises AnalysisInputError naming it."""
+    progress = read_table(os.path.join(path, "progress.csv"), PROGRESS_COLUMNS)
+    if progress is None:
         return None
-    if progress.empty or MASTERED not in progress:
-        return None
+    test_returns = read_table(os.path.join(path, "test_returns.csv"), TEST_RETURNS_COLUMNS)
+    test_set = read_table(os.path.join(path, "test_set.csv"), TEST_SET_COLUMNS)
     launch = _read_json(os.path.join(path, "launch.json"))
     run_json = _read_json(os.path.join(path, "run.json"))
     args = launch.get("args", [])
@@ -134,6 +213,13 @@ def load_run(path):
     teacher = value("teacher", "unknown")
     name = os.path.basename(os.path.normpath(path))
     seed = launch.get("seed", run_json.get("seed", given.get("seed")))
+    try:
+        seed = -1 if seed is None else int(seed)
+        if isinstance(seed, bool):
+            raise TypeError
+    except (TypeError, ValueError):
+        raise AnalysisInputError(f"{path}: the seed in launch.json / run.json is {seed!r}; "
+                                 "expected an integer") from None
     ek = value("allow_expert_knowledge", "none")
     ek = {"no": "none", "minimal": "low", "maximal": "high", "original": "high"}.get(ek, ek)
     return Run(
@@ -144,9 +230,11 @@ def load_run(path):
         ek=ek,
         embodiment=value("embodiment", "old_classic_bipedal"),
         student=value("student", "sac"),
-        seed=int(seed) if seed is not None else -1,
+        seed=seed,
         progress=progress,
         run_json=run_json,
+        test_returns=test_returns,
+        test_set=test_set,
     )
 
 
@@ -154,9 +242,14 @@ def load_results(root):
     """Every run folder under root (folders holding progress.csv), sorted by label, experiment,
     seed."""
     runs = []
-    for dirpath, dirnames, filenames in os.walk(root):
+
+    def unreadable(error):
+        raise AnalysisInputError(f"cannot read the folder {error.filename} ({error.strerror})")
+
+    for dirpath, dirnames, filenames in os.walk(root, onerror=unreadable):
         dirnames.sort()
-        if "progress.csv" in filenames:
+        # A progress.csv that is a folder is listed under dirnames: read_table refuses it.
+        if "progress.csv" in filenames or "progress.csv" in dirnames:
             run = load_run(dirpath)
             if run is not None:
                 runs.append(run)
@@ -368,21 +461,28 @@ def plot_skill_bars(table, file):
 
 
 def _teacher_records(path):
-    """teacher.jsonl -> (training tasks with env steps, dumps with env steps)."""
+    """teacher.jsonl -> (training tasks with env steps, dumps with env steps); empty without the
+    file. A line that is not a JSON record of `cradle tma run` raises AnalysisInputError."""
     tasks, steps, dumps = [], [], []
-    try:
-        with open(os.path.join(path, "teacher.jsonl")) as f:
-            for line in f:
-                if not line.strip():
-                    continue
-                rec = json.loads(line)
-                if rec.get("kind") == "train":
-                    tasks.append(rec["task"])
-                    steps.append(rec["env_steps"])
-                elif rec.get("kind") == "dump":
-                    dumps.append(rec)
-    except OSError:
-        pass
+    file = os.path.join(path, "teacher.jsonl")
+    text = _read_text(file, "the teacher.jsonl of `cradle tma run`") or ""
+    for number, line in enumerate(text.split("\n"), 1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+            if rec.get("kind") == "train":
+                task, step = [float(x) for x in rec["task"]], float(rec["env_steps"])
+                if tasks and len(task) != len(tasks[0]):
+                    raise ValueError
+                tasks.append(task)
+                steps.append(step)
+            elif rec.get("kind") == "dump":
+                float(rec["env_steps"])
+                dumps.append(rec)
+        except (ValueError, KeyError, TypeError, AttributeError):
+            raise AnalysisInputError(f"{file} line {number} is not a teacher record (cut short or "
+                                     "edited?); expected one JSON object per line") from None
     return np.asarray(tasks, dtype=np.float64), np.asarray(steps, dtype=np.float64), dumps
 
 
@@ -423,11 +523,12 @@ def _draw_dump(ax, teacher):
                                        color="C1", linewidth=0.8))
 
 
-def plot_curriculum(run, file, panels=4):
+def plot_curriculum(run, file, panels=4, records=None):
     """Tasks the teacher sampled in each quarter of training over the first two task dimensions,
     with the teacher's state at the end of that quarter (GMM ellipses, ADR box, RIAC regions).
-    Returns False when the run has no training tasks."""
-    tasks, steps, dumps = _teacher_records(run.path)
+    records: the run's _teacher_records when already read. Returns False when the run has no
+    training tasks."""
+    tasks, steps, dumps = records if records is not None else _teacher_records(run.path)
     if tasks.ndim != 2 or len(tasks) == 0:
         return False
     plt = _plt()
@@ -461,10 +562,8 @@ def plot_test_heatmap(runs, file):
     test-set dimensions. Returns False without test files."""
     test_set, mastered = None, []
     for run in runs:
-        try:
-            ts = pd.read_csv(os.path.join(run.path, "test_set.csv"))
-            tr = pd.read_csv(os.path.join(run.path, "test_returns.csv"))
-        except (OSError, pd.errors.EmptyDataError):
+        ts, tr = run.test_set, run.test_returns
+        if ts is None or tr is None:
             continue
         last = tr[tr["evaluation"] == tr["evaluation"].max()].sort_values("task_index")
         test_set = ts.sort_values("task_index")
@@ -526,11 +625,24 @@ def analyze(root, out=None, baseline=None, log=print):
     """Every figure and table of a results tree into `out` (default root/analysis); returns the
     list of files written."""
     out = out or os.path.join(root, "analysis")
+    if not os.path.isdir(root):
+        raise AnalysisInputError(f"{root} is not a folder; expected the results tree of "
+                                 "`cradle tma campaign launch`")
     runs = load_results(root)
     if not runs:
-        raise ValueError(f"no run folder with a progress.csv under {root}")
-    os.makedirs(out, exist_ok=True)
+        raise AnalysisInputError(f"no run folder with a progress.csv under {root}; expected the "
+                                 "results tree of `cradle tma campaign launch`")
     baseline = find_baseline(runs, baseline)
+    # Every input is read before the first file is written: the curricula pictured (the first
+    # seed of each label, experiment and embodiment) too.
+    curricula = {}
+    for experiment in sorted({r.experiment for r in runs}):
+        for label in sorted({r.label for r in runs if r.experiment == experiment}):
+            mine = [r for r in runs if r.experiment == experiment and r.label == label]
+            for body in sorted({r.embodiment for r in mine}):
+                first = [r for r in mine if r.embodiment == body][0]
+                curricula[first.path] = _teacher_records(first.path)
+    os.makedirs(out, exist_ok=True)
     written = []
 
     def path(name):
@@ -573,7 +685,8 @@ def analyze(root, out=None, baseline=None, log=print):
                 group = [r for r in mine if r.embodiment == body]
                 tag = f"{_safe(label)}_{_safe(experiment)}_{_safe(body)}"
                 name = f"curriculum_{tag}.png"
-                if plot_curriculum(group[0], os.path.join(out, name)):
+                if plot_curriculum(group[0], os.path.join(out, name),
+                                   records=curricula.get(group[0].path)):
                     written.append(os.path.join(out, name))
                 name = f"testset_{tag}.png"
                 if plot_test_heatmap(group, os.path.join(out, name)):
@@ -687,8 +800,10 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         analyze(args.results, args.out, args.baseline)
-    except ValueError as e:
-        print(f"cradle: error: {e}", file=sys.stderr)
+    except (ValueError, OSError) as e:
+        # One line (`cradle tma analyze` passes it on as its own error message).
+        message = " ".join(str(e).split())
+        print(f"cradle: error: {message}", file=sys.stderr)
         return 1
     return 0
 

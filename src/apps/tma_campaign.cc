@@ -855,8 +855,12 @@ int launch(const LaunchOptions& o) {
 // ---- analyze -------------------------------------------------------------------------------
 
 int analyze(const std::string& results, const std::string& out, const std::string& baseline) {
-  if (!fs::is_directory(results)) {
+  std::error_code ec;
+  if (!fs::exists(results, ec)) {
     throw UserError("results folder " + results + " does not exist (expected a campaign's tree)");
+  }
+  if (!fs::is_directory(results, ec)) {
+    throw UserError("results folder " + results + " is not a folder (expected a campaign's tree)");
   }
   const char* env_python = std::getenv("CRADLE_PYTHON");
   const std::string python = env_python && *env_python ? env_python : CRADLE_PYTHON;
@@ -869,14 +873,42 @@ int analyze(const std::string& results, const std::string& out, const std::strin
   std::vector<char*> cargv;
   for (const std::string& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
   cargv.push_back(nullptr);
+  // The script's stderr comes through a pipe: its one-line error on bad input ("cradle: error:
+  // ...", exit 1) becomes this command's own, so the user sees one line, not two.
+  int err[2];
+  if (::pipe2(err, O_CLOEXEC) != 0) throw UserError("cannot start " + python + ": no pipe");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, err[1], STDERR_FILENO);
   pid_t pid = 0;
-  if (posix_spawnp(&pid, python.c_str(), nullptr, nullptr, cargv.data(), environ) != 0) {
+  const int spawned = posix_spawnp(&pid, python.c_str(), &actions, nullptr, cargv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(err[1]);
+  if (spawned != 0) {
+    ::close(err[0]);
     throw UserError("cannot start " + python +
                     " (expected Python 3 with matplotlib, scipy, pandas)");
   }
+  // Relay the script's other stderr lines (warnings, a traceback) as they come.
+  const std::string prefix = "cradle: error: ";
+  std::string error, line;
+  FILE* stream = ::fdopen(err[0], "r");
+  for (int ch; (ch = std::fgetc(stream)) != EOF;) {
+    line += static_cast<char>(ch);
+    if (ch != '\n') continue;
+    if (line.starts_with(prefix)) {
+      error = line.substr(prefix.size(), line.size() - prefix.size() - 1);
+    } else {
+      std::fputs(line.c_str(), stderr);
+    }
+    line.clear();
+  }
+  if (!line.empty()) std::fputs(line.c_str(), stderr);
+  std::fclose(stream);
   int status = 0;
   ::waitpid(pid, &status, 0);
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+  if (code != 0 && !error.empty()) throw UserError(error);
   if (code != 0)
     throw UserError("the analysis failed (" + script + " exit " + std::to_string(code) + ")");
   return 0;

@@ -198,3 +198,86 @@ def test_a_run_folder_without_launch_json_is_read_from_run_json(tmp_path):
     assert (run.label, run.teacher, run.ek, run.embodiment, run.seed, run.experiment) == (
         "RIAC", "RIAC", "low", "fish", 7, "alone")
     assert run.final == pytest.approx(float(run.progress["pct_mastered"].iloc[-1]))
+
+
+def _first_run(root):
+    """The first run folder of a synthetic tree (sorted), where the damage goes."""
+    return sorted(p for p in pathlib.Path(root).glob("*/*") if (p / "progress.csv").exists())[0]
+
+
+def _cut(path, keep=-15):
+    data = path.read_bytes()
+    path.write_bytes(data[:keep])
+
+
+def _replace_cell(path, line, column, value):
+    rows = path.read_text().split("\n")
+    cells = rows[line - 1].split(",")
+    cells[column] = value
+    rows[line - 1] = ",".join(cells)
+    path.write_text("\n".join(rows))
+
+
+def _make_folder(path):
+    path.unlink()
+    path.mkdir()
+    (path / "inside.txt").write_text("x\n")
+
+
+# (file of the first run, damage, what the message says besides the file's path)
+DAMAGE = {
+    "progress_truncated": ("progress.csv", _cut, "is truncated"),
+    "progress_short_row": ("progress.csv", lambda p: p.write_text(p.read_text() + "1,2\n"),
+                           "has 2 cells, the header 9"),
+    "progress_not_numeric": ("progress.csv", lambda p: _replace_cell(p, 3, 1, "abc"),
+                             "line 3, column env_steps: 'abc' is not a number"),
+    "progress_folder": ("progress.csv", _make_folder, "is a folder"),
+    "progress_without_column": (
+        "progress.csv", lambda p: p.write_text(p.read_text().replace("pct_mastered", "pct")),
+        "has no column pct_mastered"),
+    "test_returns_truncated": ("test_returns.csv", _cut, "is truncated"),
+    "test_returns_not_numeric": ("test_returns.csv", lambda p: _replace_cell(p, 2, 4, "yes"),
+                                 "line 2, column mastered: 'yes' is not a number"),
+    "test_returns_folder": ("test_returns.csv", _make_folder, "is a folder"),
+    "test_set_not_numeric": ("test_set.csv", lambda p: _replace_cell(p, 2, 1, "high"),
+                             "'high' is not a number"),
+    "run_json_cut": ("run.json", _cut, "is not valid JSON"),
+    "launch_json_list": ("launch.json", lambda p: p.write_text("[1, 2]\n"),
+                         "is not a JSON object"),
+    "teacher_jsonl_cut": ("teacher.jsonl", lambda p: _cut(p, 40), "line 1 is not a teacher record"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DAMAGE))
+def test_damaged_run_files_are_one_line_naming_the_file_and_write_nothing(tmp_path, capsys,
+                                                                           case):
+    root = ta.make_synthetic_results(str(tmp_path / "r"), seeds=2, experiments=("criterion_1",),
+                                     evaluations=11, test_tasks=4, episodes_per_eval=2)
+    name, damage, says = DAMAGE[case]
+    file = _first_run(root) / name
+    damage(file)
+    out = tmp_path / "analysis"
+    assert ta.main([root, "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("cradle: error: ") and err.count("\n") == 1, err
+    assert str(file) in err and says in err, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("case", ["empty", "not_a_campaign", "missing", "a_file"])
+def test_a_folder_that_is_no_campaign_is_one_line(tmp_path, capsys, case):
+    root = tmp_path / "r"
+    if case != "missing":
+        root.mkdir()
+    if case == "not_a_campaign":
+        (root / "notes.txt").write_text("hello\n")
+        (root / "sub").mkdir()
+    if case == "a_file":
+        root.rmdir()
+        root.write_text("x\n")
+    out = tmp_path / "analysis"
+    assert ta.main([str(root), "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("cradle: error: ") and err.count("\n") == 1, err
+    assert str(root) in err and "expected the results tree" in err, err
+    assert not out.exists()
