@@ -14,8 +14,9 @@ namespace cradle::envs {
 class SamiEnvAdapter final : public Env {
  public:
   // The hidden parameters a teacher may set, as reset options: mass and damping factors
-  // (locomotion envs that vary them) and Panda's table_friction and cube_mass (kg).
-  static constexpr double kFactorRange[2] = {0.05, 5};
+  // (locomotion envs that vary them) and Panda's table_friction and cube_mass (kg). Inside the
+  // ranges task-set files may use (sami/task.h: damping beyond x3 blows the humanoids up).
+  static constexpr double kFactorRange[2] = {0.05, 3};
   static constexpr double kCellRange[2] = {0.01, 50};
 
   explicit SamiEnvAdapter(std::unique_ptr<sami::SamiEnv> env);
