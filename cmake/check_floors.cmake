@@ -22,7 +22,7 @@ set(floor_eval core model envs)
 set(floor_learn core envs)
 set(floor_teach core envs)
 set(floor_dist core)
-set(floor_train core senses envs eval learn teach sami dist)
+set(floor_train core senses envs eval learn teach tma sami dist)
 # The only env headers learn/, teach/ and eval/ may include.
 set(interface_only learn teach eval)
 set(interface_headers "envs/env.h" "envs/info.h" "envs/action_check.h")

@@ -144,6 +144,9 @@ bool run_has_env_options(const std::filesystem::path& dir) {
          run["arguments"].contains("env_options");
 }
 
+// The most --nb_env_steps (millions) a run may ask for: the paper's runs are 20.
+constexpr double kMaxMillions = 1000;
+
 struct RunOptions {
   std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
   std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
@@ -156,46 +159,14 @@ struct RunOptions {
   EnvFlags env_flags;
 };
 
-// The env family's half of a student run: envs, bounds, test set and benchmark facts.
+// The env family's half of a student run (train/tma_run.h holds the benchmark's facts).
 train::StudentEnv tma_student_env(const RunOptions& ro) {
-  const tma::EnvId id = tma::parse_env_id(ro.env);
-  tma::TmaOptions options{.env = id, .body = ro.body};
+  tma::TmaOptions options{.env = tma::parse_env_id(ro.env), .body = ro.body};
   ro.env_flags.apply(options);
-  const tma::TmaEnv probe(options);  // refuses an unknown embodiment or option now
-  using J = nlohmann::ordered_json;
-  // Stump Tracks: the criteria's 2-D space (spec §5); Parkour: the benchmark's (spec §3.2).
-  J bounds;
-  if (id == tma::EnvId::kStumpTracks) {
-    bounds["stump_height"] = {ro.min_stump_h, ro.max_stump_h};
-    bounds["obstacle_spacing"] = {0.0, ro.max_obstacle_spacing};
-  } else {
-    bounds = J::parse(R"({
-        "input_vector": [[-0.35, 0.05], [0.6, 1.0], [-0.1, 0.3]], "water_level": [0, 1],
-        "creepers_width": [0.25, 0.25], "creepers_height": [0, 4], "creepers_spacing": [0, 5],
-        "terrain_cppn_scale": [10, 10]})");
-    // Another CPPN input size: run.py's unbounded input space, [-1, 1] per input.
-    if (options.input_cppn_dim != 3) {
-      bounds["input_vector"] = J::array();
-      for (int k = 0; k < options.input_cppn_dim; ++k)
-        bounds["input_vector"].push_back({-1.0, 1.0});
-    }
-  }
-  train::StudentEnv env{
-      .make = [options] { return std::make_unique<envs::TmaEnvAdapter>(options); },
-      .space = teach::TaskSpace::from_json(bounds),
-      .reward_lb = -150,
-      .reward_ub = id == tma::EnvId::kStumpTracks ? 350.0 : 360.0};
-  // Stump Tracks' easy corner (high expert knowledge): no stumps, the largest spacing.
-  if (id == tma::EnvId::kStumpTracks) {
-    const float h = static_cast<float>(ro.max_stump_h - ro.min_stump_h);
-    const float sp = static_cast<float>(ro.max_obstacle_spacing);
-    env.initial_dist =
-        teach::DiagGaussian{.mean = {0.f, sp}, .variance = {0.01f * h * h, 0.01f * sp * sp}};
-  }
-  if (!ro.test_set.empty()) {
-    env.test_set = teach::read_test_set_csv(tma::data_dir() / (ro.test_set + ".csv"), env.space);
-  }
-  return env;
+  return train::tma_student_env(options, {.min_stump_h = ro.min_stump_h,
+                                          .max_stump_h = ro.max_stump_h,
+                                          .max_obstacle_spacing = ro.max_obstacle_spacing,
+                                          .test_set = ro.test_set});
 }
 
 // The environment and embodiment options of `random` and `run`.
@@ -368,6 +339,16 @@ void register_tma(CLI::App& app) {
     if (!(ro.nb_env_steps > 0) || !std::isfinite(ro.nb_env_steps)) {
       throw UserError("--nb_env_steps " + std::to_string(ro.nb_env_steps) +
                       " (expected a positive number of millions)");
+    }
+    // The unit is millions (run.py's): 20000 would be 2e10 steps, weeks of a cluster.
+    if (ro.nb_env_steps > kMaxMillions) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "--nb_env_steps %g is in millions of env steps (%.3g steps): expected at most "
+                    "%g (for %g steps give %g)",
+                    ro.nb_env_steps, ro.nb_env_steps * 1e6, kMaxMillions, ro.nb_env_steps,
+                    ro.nb_env_steps / 1e6);
+      throw UserError(text);
     }
     train::StudentRunOptions o{.student = ro.student,
                                .teacher = ro.teacher,

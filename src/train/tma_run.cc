@@ -10,10 +10,12 @@
 
 #include "core/error.h"
 #include "core/jsonl.h"
+#include "envs/tma/tma_env.h"
 #include "learn/learner.h"
 #include "learn/registry.h"
 #include "learn/run_files.h"
 #include "learn/vector_env.h"
+#include "tma/cppn.h"
 #include "train/curriculum_env.h"
 #include "train/loop.h"
 
@@ -161,6 +163,43 @@ std::unique_ptr<teach::Teacher> make_run_teacher(const StudentEnv& env, const St
 }
 
 }  // namespace
+
+StudentEnv tma_student_env(const tma::TmaOptions& options, const TmaBenchmark& benchmark) {
+  const tma::TmaEnv probe(options);  // refuses an unknown embodiment or option now
+  const bool stumps = options.env == tma::EnvId::kStumpTracks;
+  using J = nlohmann::ordered_json;
+  J bounds;
+  if (stumps) {
+    bounds["stump_height"] = {benchmark.min_stump_h, benchmark.max_stump_h};
+    bounds["obstacle_spacing"] = {0.0, benchmark.max_obstacle_spacing};
+  } else {
+    // The env's task parameters, the values of a vector parameter (input_vector_k) grouped.
+    for (const envs::TaskParameter& p :
+         envs::tma_task_parameters(options.env, options.input_cppn_dim)) {
+      if (p.name.starts_with("input_vector_")) {
+        bounds["input_vector"].push_back({p.low, p.high});
+      } else {
+        bounds[p.name] = {p.low, p.high};
+      }
+    }
+  }
+  StudentEnv env{.make = [options] { return std::make_unique<envs::TmaEnvAdapter>(options); },
+                 .space = teach::TaskSpace::from_json(bounds),
+                 .reward_lb = -150,
+                 .reward_ub = stumps ? 350.0 : 360.0};
+  // Stump Tracks' easy corner (high expert knowledge): no stumps, the largest spacing.
+  if (stumps) {
+    const float h = static_cast<float>(benchmark.max_stump_h - benchmark.min_stump_h);
+    const float sp = static_cast<float>(benchmark.max_obstacle_spacing);
+    env.initial_dist =
+        teach::DiagGaussian{.mean = {0.f, sp}, .variance = {0.01f * h * h, 0.01f * sp * sp}};
+  }
+  if (!benchmark.test_set.empty()) {
+    env.test_set =
+        teach::read_test_set_csv(tma::data_dir() / (benchmark.test_set + ".csv"), env.space);
+  }
+  return env;
+}
 
 std::map<std::string, std::string> student_preset(const std::string& student, long total_steps) {
   // SpinningUp SAC as TeachMyAgent runs it (spec §4.1).

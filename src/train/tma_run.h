@@ -20,6 +20,7 @@
 #include "learn/learner.h"
 #include "teach/controller.h"
 #include "teach/registry.h"
+#include "tma/tma_env.h"
 
 namespace cradle::train {
 
@@ -70,6 +71,19 @@ struct StudentRunResult {
   bool stopped = false;       // ended early by `stop`
   long checkpoint_steps = 0;  // env steps of the checkpoint that --resume continues from
 };
+
+// TeachMyAgent's benchmark as a student env (the facts of the paper's experiments): envs of the
+// given env and body options; Stump Tracks' task space is the criteria's 2-D one
+// (stump_height [min_stump_h, max_stump_h], obstacle_spacing [0, max_obstacle_spacing]) with its
+// easy corner (no stumps, the largest spacing) for high expert knowledge, Parkour's the
+// benchmark's (the env's own task parameters); returns lie in [-150, 350] (Parkour 360);
+// `test_set` names a file of data/teachmyagent (empty: the run's default). UserError for an
+// unknown body, option or test set.
+struct TmaBenchmark {
+  double min_stump_h = 0, max_stump_h = 3, max_obstacle_spacing = 6;
+  std::string test_set;
+};
+StudentEnv tma_student_env(const tma::TmaOptions& options, const TmaBenchmark& benchmark = {});
 
 // The reference presets (spec tma_sami.md §4.1, §4.2) as learner hyperparameters; total_steps caps
 // SAC's replay buffer (it never overwrites within the run either way). UserError for another

@@ -1,6 +1,7 @@
-// `cradle train --env NAME`: a MIMo sample env trained by the one training loop, with a curriculum
-// from a task-space file: progress.csv, checkpoints and the teacher's book,
-// continued by --resume; BabyBench-only flags and unknown envs are one-line errors.
+// `cradle train --env ID`: envs by id trained by the one training loop, with a curriculum from a
+// task-space file: progress.csv, checkpoints and the teacher's book, continued by --resume;
+// BabyBench-only flags, unknown envs and folders that hold a run are one-line errors; run.py's
+// budget unit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -121,6 +122,18 @@ TEST(TrainEnv, AFinishedRunIsNeverReplacedSilently) {
     EXPECT_NE(read_lines(dir / "run" / "logs" / "progress.csv"), before);
     fs::remove_all(dir / "run");
   }
+}
+
+// run.py's budget is in millions of env steps: a value meant as plain steps is refused, naming
+// the unit and what to give instead; nothing is written.
+TEST(TmaRunFlags, NbEnvStepsIsInMillions) {
+  const fs::path dir = cradle::test::fresh_dir("tma_run_millions");
+  const RunResult r = run_cradle("tma run --nb_env_steps 20000 --out run", dir);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  EXPECT_NE(r.out.find("in millions"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("give 0.02"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "run"));
 }
 
 }  // namespace
