@@ -1,0 +1,70 @@
+#include "train/episodes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace cradle::train {
+
+std::vector<EpisodeResult> run_episodes(envs::Env& env, const EpisodePolicy& policy,
+                                        std::span<const std::uint64_t> seeds, int max_steps,
+                                        const EpisodeStepFn& on_step) {
+  std::vector<double> action(env.action_space().size());
+  const int success = env.info().find("is_success");
+  const int failure = env.info().find("is_failure");
+  std::vector<EpisodeResult> out;
+  for (size_t e = 0; e < seeds.size(); ++e) {
+    EpisodeResult r{.seed = seeds[e]};
+    env.reset(seeds[e]);
+    if (policy.new_episode) policy.new_episode();
+    while (true) {
+      policy.act(env.observation(), action);
+      const envs::StepResult s = env.step(action);
+      r.episode_return += s.reward;
+      ++r.length;
+      if (on_step) on_step(static_cast<int>(e), env, s);
+      const bool capped = max_steps > 0 && r.length >= max_steps;
+      if (s.terminated || s.truncated || capped) {
+        r.truncated = !s.terminated;
+        break;
+      }
+    }
+    r.success = success >= 0 && env.info().flag(success);
+    r.failure = failure >= 0 && env.info().flag(failure);
+    r.score = env.score();
+    out.push_back(r);
+  }
+  return out;
+}
+
+nlohmann::ordered_json episodes_json(const std::vector<EpisodeResult>& episodes) {
+  nlohmann::ordered_json j;
+  double sum = 0, sum2 = 0, length = 0, successes = 0;
+  j["episodes"] = nlohmann::ordered_json::array();
+  for (const EpisodeResult& r : episodes) {
+    nlohmann::ordered_json e;
+    e["seed"] = r.seed;
+    e["return"] = r.episode_return;
+    e["length"] = r.length;
+    e["success"] = r.success;
+    e["failure"] = r.failure;
+    e["truncated"] = r.truncated;
+    if (std::isfinite(r.score)) e["score"] = r.score;
+    j["episodes"].push_back(e);
+    sum += r.episode_return;
+    sum2 += r.episode_return * r.episode_return;
+    length += r.length;
+    successes += r.success ? 1 : 0;
+  }
+  const double n = static_cast<double>(episodes.size());
+  if (n > 0) {
+    const double mean = sum / n;
+    j["mean_return"] = mean;
+    j["std_return"] = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+    j["mean_length"] = length / n;
+    j["success_rate"] = successes / n;
+  }
+  return j;
+}
+
+}  // namespace cradle::train

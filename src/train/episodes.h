@@ -1,0 +1,46 @@
+// One evaluation rollout for every env family: whole episodes of a policy on an env, each from
+// its own seed, with what the run records of each (return, length, the task's success and
+// failure flags and score). Runs by env id evaluate their trained policy with it.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <vector>
+
+#include "envs/env.h"
+
+namespace cradle::train {
+
+struct EpisodeResult {
+  std::uint64_t seed = 0;
+  double episode_return = 0;
+  int length = 0;
+  bool success = false;  // info "is_success" at the episode's last step (false without one)
+  bool failure = false;  // info "is_failure" likewise
+  double score = 0;      // the env's score() at the end (NaN when the task has none)
+  bool truncated = false;
+};
+
+// The policy: writes the action for an observation. `new_episode` is called before each
+// episode's first action (a policy with memory restarts it).
+struct EpisodePolicy {
+  std::function<void(const envs::ObservationBuffers&, std::span<double>)> act;
+  std::function<void()> new_episode;
+};
+
+// Called after every step (e.g. to film or trace), with the episode's index.
+using EpisodeStepFn = std::function<void(int episode, const envs::Env&, const envs::StepResult&)>;
+
+// Plays one episode per seed on `env` (reset with that seed) until it terminates or truncates,
+// or after max_steps steps when max_steps > 0 (then counted as truncated).
+std::vector<EpisodeResult> run_episodes(envs::Env& env, const EpisodePolicy& policy,
+                                        std::span<const std::uint64_t> seeds, int max_steps = 0,
+                                        const EpisodeStepFn& on_step = nullptr);
+
+// The results as evaluation.json writes them: per episode, then mean and std of the return,
+// the mean length and the success rate.
+nlohmann::ordered_json episodes_json(const std::vector<EpisodeResult>& episodes);
+
+}  // namespace cradle::train
