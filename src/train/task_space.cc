@@ -36,7 +36,8 @@ nlohmann::ordered_json to_json(const YAML::Node& node) {
 
 }  // namespace
 
-CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source) {
+CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source,
+                                bool need_teacher) {
   nlohmann::ordered_json j;
   try {
     j = to_json(YAML::Load(yaml_text));
@@ -92,19 +93,20 @@ CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string&
       throw UserError(source + ": unknown key '" + key + "' (expected " + keys + ")");
     }
   }
-  if (spec.teacher.empty()) throw UserError(source + ": no teacher (e.g. teacher: ALP-GMM)");
+  if (need_teacher && spec.teacher.empty())
+    throw UserError(source + ": no teacher (e.g. teacher: ALP-GMM)");
   if (!j.contains("params")) {
     throw UserError(source + ": no params (e.g. params: {start_posture_range: [0, 1]})");
   }
   return spec;
 }
 
-CurriculumSpec load_task_space(const std::filesystem::path& file) {
+CurriculumSpec load_task_space(const std::filesystem::path& file, bool need_teacher) {
   std::ifstream in(file);
   if (!in) throw UserError("--task-space '" + file.string() + "' cannot be read");
   std::stringstream text;
   text << in.rdbuf();
-  return parse_task_space(text.str(), file.string());
+  return parse_task_space(text.str(), file.string(), need_teacher);
 }
 
 std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
@@ -119,8 +121,15 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
       .reward_ub = spec.reward_ub,
       .scale_reward = spec.scale_reward,
       .params = spec.teacher_params};
+  return make_controller(spec, teach::make_teacher(setup), seed);
+}
+
+std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
+                                                          std::unique_ptr<teach::Teacher> teacher,
+                                                          std::uint64_t seed) {
+  // The controller checks the teacher's dimension against the space's.
   return std::make_shared<teach::TeacherController>(
-      teach::make_teacher(setup), *spec.space,
+      std::move(teacher), *spec.space,
       teach::ControllerOptions{.seed = seed,
                                .scale_reward = spec.scale_reward,
                                .reward_lb = spec.reward_lb,

@@ -1,6 +1,7 @@
 // A curriculum for any env that takes its task as reset options (`cradle train --task-space`):
 // the YAML file names the teacher, the task space and the teacher's parameters (docs/curricula.md).
-//   teacher: ALP-GMM                       # one of teach::teacher_names()
+//   teacher: ALP-GMM                       # one of teach::teacher_names(); optional when the run
+//                                          # names one or brings its own (TeacherFactory)
 //   params:                                # name: [min, max] | [min, max, n] | [[min, max], ...]
 //     start_posture_range: [0, 1]
 //   teacher_params: {fit_rate: 50}         # the reference's kwarg names (optional)
@@ -15,6 +16,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -35,15 +37,27 @@ struct CurriculumSpec {
   bool scale_reward = false;
 };
 
-// Parses the YAML text (`source` names it in errors). UserError, one line, for an unknown key, a
-// missing teacher or params, malformed bounds or a value of the wrong type.
-CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source);
-CurriculumSpec load_task_space(const std::filesystem::path& file);
+// Parses the YAML text (`source` names it in errors). UserError, one line, for an unknown key,
+// missing params (or a missing teacher when need_teacher), malformed bounds or a value of the
+// wrong type.
+CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source,
+                                bool need_teacher = true);
+CurriculumSpec load_task_space(const std::filesystem::path& file, bool need_teacher = true);
+
+// A teacher of the caller's own (e.g. a Python object's, src/python/python_teacher.h) for a task
+// space, seeded by the run; it replaces the file's named teacher.
+using TeacherFactory = std::function<std::unique_ptr<teach::Teacher>(const teach::TaskSpace& space,
+                                                                     std::uint64_t seed)>;
 
 // The controller of a spec: its teacher seeded with `seed` (UserError for an unknown teacher or
 // a bad parameter); the test set is the default one (curricula here have no evaluation of their
 // own).
 std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
+                                                          std::uint64_t seed);
+// The same controller around a ready teacher (spec.teacher, teacher_params and expert_knowledge
+// unused): UserError for a null teacher or one of another dimension than the space.
+std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
+                                                          std::unique_ptr<teach::Teacher> teacher,
                                                           std::uint64_t seed);
 
 }  // namespace cradle::train

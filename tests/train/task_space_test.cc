@@ -6,10 +6,15 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "envs/babybench.h"
 #include "envs/mimo/sample_env.h"
+#include "fixture.h"
+#include "train/trainer.h"
 
 namespace cradle::train {
 namespace {
@@ -83,6 +88,90 @@ TEST(TaskSpaceFile, ShippedBabyBenchExampleLoads) {
   EXPECT_EQ(spec.space->dim_names(), std::vector<std::string>{"start_posture_range"});
   EXPECT_TRUE(std::isnan(spec.env_options.success_threshold));
   EXPECT_NO_THROW(make_controller(spec, 1));
+}
+
+TEST(TaskSpaceFile, ATeacherOfTheRunsOwnNeedsNoTeacherKey) {
+  EXPECT_THROW(parse_task_space("params: {a: [0, 1]}", "t.yml"), UserError);
+  const CurriculumSpec spec =
+      parse_task_space("params: {a: [0, 1], b: [2, 3]}", "t.yml", /*need_teacher=*/false);
+  EXPECT_TRUE(spec.teacher.empty());
+  auto controller = make_controller(spec, teach::make_random_teacher({0, 2}, {1, 3}, 4), 4);
+  const teach::SampledTask t = controller->sample_train_task();
+  ASSERT_EQ(t.real.size(), 2u);
+  EXPECT_GE(t.real[1], 2.f);
+  // A teacher of another dimension, or none, is refused.
+  EXPECT_THROW(make_controller(spec, teach::make_random_teacher({0}, {1}, 4), 4), UserError);
+  EXPECT_THROW(make_controller(spec, nullptr, 4), UserError);
+}
+
+// Hands out task k = (k % 24 / 8, k / 24 / 8) and records what it hears.
+class Scripted final : public teach::Teacher {
+ public:
+  struct Log {
+    std::mutex mutex;
+    std::vector<teach::Task> handed, updated;
+    std::vector<double> returns;
+    std::uint64_t seed = 0;
+  };
+  Scripted(const teach::TaskSpace& space, std::uint64_t seed, std::shared_ptr<Log> log)
+      : Teacher(space.mins(), space.maxs(), seed), log_(std::move(log)) {
+    log_->seed = seed;
+  }
+  teach::Task sample_task() override {
+    std::lock_guard lock(log_->mutex);
+    const int k = static_cast<int>(log_->handed.size());
+    log_->handed.push_back({(k % 24) * 0.125f, (k / 24) * 0.125f});
+    return log_->handed.back();
+  }
+  void episodic_update(const teach::Task& task, double ret, bool) override {
+    std::lock_guard lock(log_->mutex);
+    log_->updated.push_back(task);
+    log_->returns.push_back(ret);
+  }
+  const char* name() const override { return "Scripted"; }
+
+ private:
+  std::shared_ptr<Log> log_;
+};
+
+TEST(CurriculumRun, ATeacherObjectDrivesARunInsteadOfTheFilesTeacher) {
+  const std::filesystem::path dir = test::fresh_dir("curriculum_teacher_object");
+  std::ofstream(dir / "space.yml") << "params:\n  stump_height: [0, 3]\n"
+                                   << "  obstacle_spacing: [0, 6]\n";
+  Config config;
+  config.save_dir = (dir / "run").string();
+  TrainOptions o{.env = "tma/stump-tracks:old_classic_bipedal",
+                 .algorithm = "ppo",
+                 .intrinsic = "",
+                 .steps = 2048,
+                 .envs = 2,
+                 .seed = 7};
+  o.progress_bar = false;
+  o.hyperparameters = {{"n_steps", "64"}, {"batch_size", "64"}, {"n_epochs", "1"}};
+  o.task_space = (dir / "space.yml").string();
+  auto log = std::make_shared<Scripted::Log>();
+  o.teacher_factory = [log](const teach::TaskSpace& space, std::uint64_t seed) {
+    return std::make_unique<Scripted>(space, seed, log);
+  };
+  // A name and an object at once are refused.
+  TrainOptions both = o;
+  both.teacher = "Random";
+  EXPECT_THROW(train(config, both), UserError);
+  train(config, o);
+  EXPECT_EQ(log->seed, 7u);
+  // teacher.jsonl books the episodes in the order the teacher heard them.
+  std::ifstream in(dir / "run" / "logs" / "teacher.jsonl");
+  std::vector<teach::Task> booked;
+  nlohmann::json last;
+  for (std::string line; std::getline(in, line);) {
+    last = nlohmann::json::parse(line);
+    if (last["kind"] == "train") booked.push_back(last["task"].get<teach::Task>());
+  }
+  ASSERT_FALSE(booked.empty());
+  EXPECT_EQ(booked, log->updated);
+  EXPECT_LE(log->handed.size() - booked.size(), 2u);  // the episodes the run's end cut short
+  EXPECT_EQ(last["teacher"]["teacher"], "Scripted");
+  std::filesystem::remove_all(dir);
 }
 
 // A shipped task-space file's spec and a controller seeded 3.
