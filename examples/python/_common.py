@@ -50,8 +50,9 @@ def train_ppo(config, wrapper_class, reward_fn, train_for):
         print(f"SB3 PPO model saved to {os.path.join(save_dir, 'model.zip')}")
         return
     print("stable_baselines3 is not installed: training with Cradle's PPO (C++)")
+    # As the reference's scripts do, a rerun replaces the previous run in save_dir.
     result = cradle.train(config, algo="ppo", intrinsic=[reward_fn], steps=train_for, envs=1,
-                          eval_episodes=0)
+                          eval_episodes=0, overwrite=True)
     print(f"trained {result['steps']} steps at {result['steps_per_second']:.0f} steps/s; "
           f"checkpoint {result['checkpoint']}; training score {result['training_score']}")
 

@@ -60,9 +60,9 @@ def _split_intrinsic(intrinsic):
 
 
 def train(
-    config,
+    config=None,
     algo="ppo",
-    intrinsic=("body_part_novelty",),
+    intrinsic=None,
     steps=100_000,
     envs=2,
     threads=0,
@@ -77,15 +77,36 @@ def train(
     eval_render=True,
     compare_random=False,
     progress_bar=True,
+    *,
+    env=None,
+    save_dir=None,
+    task_space=None,
+    teacher=None,
+    overwrite=False,
 ):
     """Trains a policy with Cradle's C++ learners, exactly as `cradle train` does (same options,
     same outputs under save_dir: training log, logs/progress.csv, checkpoints/, plots/, the
     evaluation of the trained policy).
 
+    config: a BabyBench config (dict or YAML path); or env: any env id of cradle.env_ids() (a
+      BabyBench id trains its config; the others train by id into save_dir, default
+      results/<id>, with logs/progress.csv, checkpoints/ and plots/). algo: any learner of
+      `cradle train --help` (ppo, a2c, sac, td3, ddpg, tesac, ccm, satesac, saccm, saccm_all).
+    task_space / teacher: a curriculum (a task-space YAML whose teacher sets the env's task
+      parameters before every reset; teacher overrides the file's), as --task-space / --teacher.
+      teacher may also be a Python object with sample_task() and episodic_update(task,
+      episode_return, success), optionally dump() and non_exploratory_task_sampling()
+      (docs/curricula.md, "A teacher of your own, in Python"): a missing method or a task outside
+      the task space is a ValueError; an exception the teacher raises stops the run as a
+      RuntimeError with its message (the teacher's exception as its __cause__).
+    save_dir: the run folder (overrides the config's). A folder that already holds a run is
+      refused (ValueError) unless resume=True continues it or overwrite=True replaces it.
+
     intrinsic: a list of reward terms, each a registered name ("touch_count", "saliency",
       "body_part_novelty", "rnd", "icm", "disagreement", "hand_visibility"; "name:weight" also
       works), a Python callable, or a (name or callable, weight) pair; [] trains on the env reward
-      (0 for BabyBench) only. A callable is called once per env and vector step as fn(obs) or
+      (0 for BabyBench) only. Default: body_part_novelty for BabyBench configs, none for an env
+      id. A callable is called once per env and vector step as fn(obs) or
       fn(obs, action, info) and returns a float; obs holds read-only views of the env's buffers,
       valid only during the call (copy what you keep). The C++ loop takes the GIL once per vector
       step for these calls; their cost is the Python calls themselves (about a microsecond each
@@ -94,17 +115,28 @@ def train(
     async_batch: K > 0 collects PPO/A2C rollouts asynchronously in batches of the first K of the
       envs to finish (as --async-batch; 1 <= K < envs); 0: lock-step.
 
-    Returns a dict: steps, seconds, steps_per_second, training_score, checkpoint, evaluation
-    (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
+    Returns a dict: run (the run folder), steps, seconds, steps_per_second, training_score,
+    checkpoint, evaluation (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
     KeyboardInterrupt.
     """
+    if (config is None) == (env is None):
+        raise ValueError("give config (a BabyBench config) or env (an env id), not "
+                         + ("both" if config is not None else "neither"))
+    if env is not None and not isinstance(env, str):
+        raise ValueError(f"env must be an env id (a str), not {type(env).__name__}")
+    if intrinsic is None:
+        intrinsic = ("body_part_novelty",) if config is not None else ()
     spec, terms = _split_intrinsic(intrinsic)
     hp = {str(k): str(v) for k, v in (hyperparameters or {}).items()}
+    base = load_config(config) if config is not None else _cradle.default_config()
     result = _cradle.train(
-        load_config(config), algo, spec, int(steps), int(envs), int(threads), int(async_batch),
+        base, algo, spec, int(steps), int(envs), int(threads), int(async_batch),
         int(seed), bool(resume), bool(randomize_start), int(checkpoint_every), hp,
         int(eval_episodes), int(eval_duration), bool(eval_render), bool(compare_random),
-        bool(progress_bar), terms,
+        bool(progress_bar), terms, env=env or "",
+        save_dir=os.fspath(save_dir) if save_dir is not None else "",
+        task_space=os.fspath(task_space) if task_space is not None else "",
+        teacher="" if teacher is None else teacher, overwrite=bool(overwrite),
     )
     for key in ("evaluation", "random_evaluation"):
         if result[key] is not None:

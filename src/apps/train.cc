@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -136,9 +137,8 @@ void register_train(CLI::App& app) {
     // A BabyBench id trains its config, with everything a config run has.
     bool babybench_id = false;
     if (!opts->train.env.empty()) {
-      const envs::EnvSpec spec = envs::env_spec(train::registered_env_id(opts->train.env));
-      if (spec.family == "babybench") {
-        config = spec.config.empty() ? default_config() : load_config(spec.config);
+      if (const std::optional<Config> c = train::babybench_config(opts->train.env)) {
+        config = *c;
         opts->train.env.clear();
         babybench_id = true;
       }

@@ -18,6 +18,7 @@
 #include "eval/scores.h"
 #include "learn/vector_env.h"
 #include "python/common.h"
+#include "python/python_teacher.h"
 #include "train/babybench_vector.h"
 #include "train/evaluation.h"
 #include "train/trainer.h"
@@ -416,8 +417,23 @@ void bind_learn(py::module_& m) {
          bool randomize_start, long checkpoint_every,
          const std::map<std::string, std::string>& hyperparameters, int eval_episodes,
          int eval_duration, bool eval_render, bool compare_random, bool progress_bar,
-         const py::list& terms) {
-        train::TrainOptions o{.algorithm = algorithm,
+         const py::list& terms, const std::string& env, const std::string& save_dir,
+         const std::string& task_space, const py::object& teacher, bool overwrite) {
+        // An env id of any family: a BabyBench id trains its config, the others by id (their
+        // run folder: save_dir, else results/<id>).
+        Config run_config = config;
+        std::string by_id;
+        if (!env.empty()) {
+          if (const std::optional<Config> c = train::babybench_config(env)) {
+            run_config = *c;
+          } else {
+            by_id = train::registered_env_id(env);
+            run_config.save_dir = "results/" + by_id;
+          }
+        }
+        if (!save_dir.empty()) run_config.save_dir = save_dir;
+        train::TrainOptions o{.env = by_id,
+                              .algorithm = algorithm,
                               .intrinsic = intrinsic,
                               .steps = steps,
                               .envs = envs,
@@ -433,6 +449,16 @@ void bind_learn(py::module_& m) {
                               .eval_render = eval_render,
                               .compare_random = compare_random,
                               .progress_bar = progress_bar};
+        o.task_space = task_space;
+        // A teacher by name, or a Python object (its protocol checked before anything runs).
+        std::optional<PythonTeacher> own_teacher;
+        if (py::isinstance<py::str>(teacher)) {
+          o.teacher = teacher.cast<std::string>();
+        } else if (!teacher.is_none()) {
+          own_teacher.emplace(teacher);
+          o.teacher_factory = own_teacher->factory();
+        }
+        o.overwrite = overwrite;
         std::vector<PyTerm> py_terms;
         for (const py::handle t : terms) {
           const py::tuple tt = py::reinterpret_borrow<py::tuple>(t);
@@ -441,13 +467,22 @@ void bind_learn(py::module_& m) {
         auto hook = std::make_shared<PyRewardHook>(std::move(py_terms));
         o.reward_hook = [hook](const learn::VecEnv& env, std::span<const double> actions,
                                std::span<double> rewards) { (*hook)(env, actions, rewards); };
-        const train::TrainResult r = without_gil([&] { return train::train(config, o); });
+        const train::TrainResult r = [&] {
+          try {
+            return without_gil([&] { return train::train(run_config, o); });
+          } catch (const PythonTeacherError&) {
+            // The teacher's own exception, as the cause of a RuntimeError with its message.
+            if (own_teacher) own_teacher->raise_if_failed();
+            throw;
+          }
+        }();
         py::dict out;
         out["steps"] = r.steps;
         out["seconds"] = r.seconds;
         out["steps_per_second"] = r.steps_per_second;
         out["training_score"] = r.training_score ? py::cast(*r.training_score) : py::none();
         out["checkpoint"] = r.checkpoint.string();
+        out["run"] = run_config.save_dir;
         out["evaluation"] = r.evaluation ? py::cast(r.evaluation->to_json().dump()) : py::none();
         out["random_evaluation"] =
             r.random_evaluation ? py::cast(r.random_evaluation->to_json().dump()) : py::none();
@@ -458,8 +493,10 @@ void bind_learn(py::module_& m) {
       py::arg("resume"), py::arg("randomize_start"), py::arg("checkpoint_every"),
       py::arg("hyperparameters"), py::arg("eval_episodes"), py::arg("eval_duration"),
       py::arg("eval_render"), py::arg("compare_random"), py::arg("progress_bar"), py::arg("terms"),
+      py::arg("env") = "", py::arg("save_dir") = "", py::arg("task_space") = "",
+      py::arg("teacher") = "", py::arg("overwrite") = false,
       "Trains with the C++ learners (see cradle.train). Python reward terms are (fn, weight, "
-      "full) tuples.");
+      "full) tuples; teacher is a teacher's name or a Python teacher object.");
 
   py::class_<PyPolicy>(m, "Policy", "A trained checkpoint's deterministic policy.")
       .def_readonly("action_dim", &PyPolicy::action_dim);

@@ -136,8 +136,13 @@ bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& sc
 }  // namespace
 
 namespace {
-// This process's rank in a data-parallel run (0 when alone).
-int rank_of(learn::GradSync* sync) { return distributed(sync) ? sync->rank() : 0; }
+// Whether a progress.csv holds a row past its header (a run that failed before its first report
+// leaves the header only).
+bool has_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  return std::getline(in, line) && std::getline(in, line) && !line.empty();
+}
 }  // namespace
 
 std::string registered_env_id(const std::string& name) {
@@ -145,6 +150,12 @@ std::string registered_env_id(const std::string& name) {
   for (const char* short_name : {"reach", "standup", "selfbody", "catch"})
     if (name == short_name) return "mimo/" + name;
   return envs::env_spec(name).id;  // UserError naming the closest ids
+}
+
+std::optional<Config> babybench_config(const std::string& name) {
+  const envs::EnvSpec spec = envs::env_spec(registered_env_id(name));
+  if (spec.family != "babybench") return std::nullopt;
+  return spec.config.empty() ? default_config() : load_config(spec.config);
 }
 
 TrainResult train(const Config& config, const TrainOptions& options) {
@@ -182,26 +193,6 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (options.resume && !fs::exists(latest)) {
     throw UserError("--resume: no checkpoint at '" + latest.string() + "'");
   }
-  // A folder that holds a run is never replaced silently: --resume continues it, --overwrite
-  // replaces it (its checkpoints, logs and plots go first), anything else is refused.
-  if (!options.resume) {
-    std::error_code ec;
-    const fs::path progress = dir / "logs" / "progress.csv";
-    const bool holds_run = fs::exists(latest, ec) || fs::exists(progress, ec);
-    if (holds_run && !options.overwrite) {
-      throw UserError("'" + dir.string() + "' holds a run (" +
-                      (fs::exists(latest, ec) ? latest : progress).string() +
-                      "): give --resume to continue it, --overwrite to replace it, or another "
-                      "--save-dir");
-    }
-    if (holds_run && rank_of(options.sync.get()) == 0) {
-      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
-        fs::remove_all(dir / sub, ec);
-        if (ec) throw UserError("--overwrite: cannot remove '" + (dir / sub).string() + "'");
-      }
-    }
-  }
-
   // A resumed run keeps its algorithm; --hp values override the checkpoint's (those that fix
   // network shapes or observation settings are then refused by load()). The logs are cut back to
   // what the checkpoint knows.
@@ -259,6 +250,26 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                 {"--resume", options.resume ? 1.0 : 0.0},
                 {"the checkpoint's step", static_cast<double>(resumed.steps)}});
   }
+  // A folder that holds a run (a checkpoint, or progress rows) is never replaced silently:
+  // --resume continues it, --overwrite replaces it (its checkpoints, logs and plots go first),
+  // anything else is refused. Checked after the options, before anything is written.
+  if (!options.resume) {
+    std::error_code ec;
+    const fs::path progress = dir / "logs" / "progress.csv";
+    const bool holds_run = fs::exists(latest, ec) || has_rows(progress);
+    if (holds_run && !options.overwrite) {
+      throw UserError("'" + dir.string() + "' holds a run (" +
+                      (fs::exists(latest, ec) ? latest : progress).string() +
+                      "): give --resume to continue it, --overwrite to replace it, or another "
+                      "--save-dir");
+    }
+    if (holds_run && rank == 0) {
+      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
+        fs::remove_all(dir / sub, ec);
+        if (ec) throw UserError("--overwrite: cannot remove '" + (dir / sub).string() + "'");
+      }
+    }
+  }
   Config env_config = config;
   if (rank > 0) env_config.save_dir = (dir / "ranks" / std::to_string(rank)).string();
   const fs::path log_file = fs::path(env_config.save_dir) / "logs" / "training.jsonl";
@@ -272,12 +283,20 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   const fs::path teacher_file = fs::path(env_config.save_dir) / "logs" / "teacher.jsonl";
   std::shared_ptr<teach::TeacherController> curriculum;
   EnvWrapper wrap;
-  if (!options.teacher.empty() && options.task_space.empty())
+  if ((!options.teacher.empty() || options.teacher_factory) && options.task_space.empty())
     throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
+  if (!options.teacher.empty() && options.teacher_factory)
+    throw UserError("a teacher name and a teacher object: give one of them");
   if (!options.task_space.empty()) {
-    CurriculumSpec spec = load_task_space(options.task_space);
+    // A teacher given by the run needs none named in the file.
+    const bool own = !options.teacher.empty() || options.teacher_factory;
+    CurriculumSpec spec = load_task_space(options.task_space, /*need_teacher=*/!own);
     if (!options.teacher.empty()) spec.teacher = options.teacher;
-    curriculum = make_controller(spec, options.seed + rank);  // a teacher per rank
+    const std::uint64_t teacher_seed = options.seed + rank;  // a teacher per rank
+    curriculum = options.teacher_factory
+                     ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed),
+                                       teacher_seed)
+                     : make_controller(spec, teacher_seed);
     if (options.resume && fs::exists(teacher_file)) {
       for (const nlohmann::json& e : read_jsonl(teacher_file))
         if (e.value("kind", "") == "train")

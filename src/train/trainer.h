@@ -15,6 +15,7 @@
 #include "core/config.h"
 #include "learn/learner.h"
 #include "train/evaluation.h"
+#include "train/task_space.h"
 
 namespace cradle::train {
 
@@ -64,6 +65,9 @@ struct TrainOptions {
   // options; `teacher` overrides the file's. Its book goes to <save_dir>/logs/teacher.jsonl.
   std::string task_space;
   std::string teacher;
+  // A teacher object instead of a name (e.g. Python's, cradle.train(teacher=obj)): made once per
+  // rank with the task space and the rank's seed; the file's teacher key may then be left out.
+  TeacherFactory teacher_factory;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
   // A data-parallel run's ranks (docs/distributed.md); null or one rank: this process alone. Rank
@@ -86,6 +90,10 @@ struct TrainResult {
 // The registered id of an env name: an id, an alias or a MIMo sample task's short name. UserError
 // naming the closest ids for an unknown one.
 std::string registered_env_id(const std::string& name);
+
+// The config a BabyBench id trains as (the registry's file, or the documented defaults); nullopt
+// for an id of another family. UserError naming the closest ids for an unknown one.
+std::optional<Config> babybench_config(const std::string& name);
 
 // With options.env set, only config.save_dir is read.
 TrainResult train(const Config& config, const TrainOptions& options);
