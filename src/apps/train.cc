@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,15 @@ void report_files(const Config& config, const train::TrainOptions& train,
         "random = %.2f)\n",
         r.random_evaluation->episodes.size(), r.random_evaluation->mean, r.random_evaluation->std,
         r.evaluation ? r.evaluation->mean / r.random_evaluation->mean : 0.0);
+  }
+  if (!r.episodes.empty()) {
+    const nlohmann::ordered_json e = train::episodes_json(r.episodes);
+    std::printf(
+        "evaluation of the trained policy (%zu episodes): return %.4g +- %.4g, length %.0f, "
+        "success %.0f%% (%s/evaluation.json)\n",
+        r.episodes.size(), e["mean_return"].get<double>(), e["std_return"].get<double>(),
+        e["mean_length"].get<double>(), 100 * e["success_rate"].get<double>(),
+        config.save_dir.c_str());
   }
   if (!train.env.empty()) {
     std::printf("logs: %s/logs/progress.csv%s; plots: %s/plots/\n", config.save_dir.c_str(),
@@ -148,15 +158,13 @@ void register_train(CLI::App& app) {
         throw UserError("give --config FILE.yml (BabyBench) or --env ID (`cradle envs`)");
       if (!babybench_id) config = load_config(opts->config);
     } else {
-      for (const char* flag :
-           {"--randomize-start", "--compare-random", "--eval-episodes", "--no-eval-video"}) {
+      for (const char* flag : {"--randomize-start", "--compare-random", "--no-eval-video"}) {
         if (cmd->get_option(flag)->count() > 0)
           throw UserError(std::string(flag) + " is for BabyBench configs, not --env " +
                           opts->train.env);
       }
       // The env's own reward unless intrinsic rewards are asked for.
       if (cmd->get_option("--intrinsic")->count() == 0) opts->train.intrinsic.clear();
-      opts->train.eval_episodes = 0;
       config.save_dir = "results/" + train::registered_env_id(opts->train.env);
     }
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;

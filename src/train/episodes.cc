@@ -6,15 +6,15 @@
 
 namespace cradle::train {
 
-std::vector<EpisodeResult> run_episodes(envs::Env& env, const EpisodePolicy& policy,
-                                        std::span<const std::uint64_t> seeds, int max_steps,
-                                        const EpisodeStepFn& on_step) {
+std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
+                                         std::span<const std::uint64_t> seeds, int max_steps,
+                                         const EpisodeStepFn& on_step) {
   std::vector<double> action(env.action_space().size());
   const int success = env.info().find("is_success");
   const int failure = env.info().find("is_failure");
-  std::vector<EpisodeResult> out;
+  std::vector<EpisodeOutcome> out;
   for (size_t e = 0; e < seeds.size(); ++e) {
-    EpisodeResult r{.seed = seeds[e]};
+    EpisodeOutcome r{.seed = seeds[e]};
     env.reset(seeds[e]);
     if (policy.new_episode) policy.new_episode();
     while (true) {
@@ -37,11 +37,11 @@ std::vector<EpisodeResult> run_episodes(envs::Env& env, const EpisodePolicy& pol
   return out;
 }
 
-nlohmann::ordered_json episodes_json(const std::vector<EpisodeResult>& episodes) {
+nlohmann::ordered_json episodes_json(const std::vector<EpisodeOutcome>& episodes) {
   nlohmann::ordered_json j;
   double sum = 0, sum2 = 0, length = 0, successes = 0;
   j["episodes"] = nlohmann::ordered_json::array();
-  for (const EpisodeResult& r : episodes) {
+  for (const EpisodeOutcome& r : episodes) {
     nlohmann::ordered_json e;
     e["seed"] = r.seed;
     e["return"] = r.episode_return;

@@ -13,7 +13,7 @@
 
 namespace cradle::train {
 
-struct EpisodeResult {
+struct EpisodeOutcome {
   std::uint64_t seed = 0;
   double episode_return = 0;
   int length = 0;
@@ -35,12 +35,12 @@ using EpisodeStepFn = std::function<void(int episode, const envs::Env&, const en
 
 // Plays one episode per seed on `env` (reset with that seed) until it terminates or truncates,
 // or after max_steps steps when max_steps > 0 (then counted as truncated).
-std::vector<EpisodeResult> run_episodes(envs::Env& env, const EpisodePolicy& policy,
-                                        std::span<const std::uint64_t> seeds, int max_steps = 0,
-                                        const EpisodeStepFn& on_step = nullptr);
+std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
+                                         std::span<const std::uint64_t> seeds, int max_steps = 0,
+                                         const EpisodeStepFn& on_step = nullptr);
 
 // The results as evaluation.json writes them: per episode, then mean and std of the return,
 // the mean length and the success rate.
-nlohmann::ordered_json episodes_json(const std::vector<EpisodeResult>& episodes);
+nlohmann::ordered_json episodes_json(const std::vector<EpisodeOutcome>& episodes);
 
 }  // namespace cradle::train

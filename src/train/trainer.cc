@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/jsonl.h"
+#include "core/sealed_file.h"
 #include "envs/babybench.h"
 #include "envs/registry.h"
 #include "eval/figures.h"
@@ -392,6 +393,24 @@ TrainResult train(const Config& config, const TrainOptions& options) {
 
   // progress.csv: continued on resume, cut back to the checkpoint's step (later rows and a torn
   // line kept aside); another version's file is kept beside a new one.
+  // run.json: what this run is (a fresh run writes it; a resumed one keeps it).
+  if (rank == 0 && !options.resume) {
+    nlohmann::ordered_json run = {{"cradle_version", CRADLE_VERSION},
+                                  {"env", by_id ? env_id : "babybench config"},
+                                  {"family", by_id ? envs::env_spec(env_id).family : "babybench"},
+                                  {"algorithm", algorithm},
+                                  {"seed", options.seed},
+                                  {"steps", options.steps},
+                                  {"envs", options.envs},
+                                  {"checkpoint_every", options.checkpoint_every},
+                                  {"intrinsic", reward ? reward->describe() : ""},
+                                  {"hyperparameters", hyperparameters},
+                                  {"task_space", options.task_space},
+                                  {"teacher", options.teacher},
+                                  {"world_size", sync ? sync->world_size() : 1}};
+    if (!by_id) run["config"] = to_json(config);
+    write_atomically(dir / "run.json", run.dump(2) + "\n");
+  }
   const fs::path csv_file = dir / "logs" / "progress.csv";
   std::string header;
   for (size_t c = 0; c < std::size(kColumns); ++c)
@@ -503,6 +522,28 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (!by_id && fs::exists(log_file))
     result.training_score = eval::training_score(
         config.behavior, eval::read_training_log(log_file, config.behavior, training.geom_count));
+
+  // A run by id: the trained policy's whole episodes on a fresh env, acting deterministically
+  // from seeds apart from training's (evaluation.json).
+  if (by_id && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
+    std::unique_ptr<envs::Env> env = envs::make_env(env_id, options.seed + 1000);
+    std::vector<std::uint64_t> seeds;
+    for (int k = 0; k < options.eval_episodes; ++k) seeds.push_back(options.seed + 1000 + k);
+    Learner* l = learner.get();
+    result.episodes = run_episodes(
+        *env,
+        {.act = [l](const envs::ObservationBuffers& obs,
+                    std::span<double> action) { l->act(obs, action, /*deterministic=*/true); },
+         .new_episode = [l] { l->new_episode(); }},
+        seeds);
+    env->close();
+    nlohmann::ordered_json report = {{"env", env_id},
+                                     {"algorithm", algorithm},
+                                     {"steps", learner->steps()},
+                                     {"policy_actions", "mean"}};
+    report.update(episodes_json(result.episodes));
+    write_atomically(dir / "evaluation.json", report.dump(2) + "\n");
+  }
 
   // The trained policy's evaluation, acting deterministically.
   if (!by_id && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {

@@ -14,6 +14,7 @@
 
 #include "core/config.h"
 #include "learn/learner.h"
+#include "train/episodes.h"
 #include "train/evaluation.h"
 #include "train/task_space.h"
 
@@ -83,6 +84,8 @@ struct TrainResult {
   std::optional<double> training_score;  // from the env training log
   std::optional<train::EvaluationReport> evaluation;
   std::optional<train::EvaluationReport> random_evaluation;
+  // A run by env id: its trained policy's episodes (train::run_episodes, evaluation.json).
+  std::vector<EpisodeOutcome> episodes;
   std::filesystem::path checkpoint;
   std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };

@@ -88,7 +88,7 @@ TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
   for (const std::string& args : std::vector<std::string>{
            "train", "train --env fly", "train --env reach --config " + config,
            "train --env tma/parkour", "train --env reach --randomize-start",
-           "train --env reach --compare-random", "train --env reach --eval-episodes 3",
+           "train --env reach --compare-random", "train --env reach --no-eval-video",
            "train --env reach --teacher Random"}) {
     const RunResult r = run_cradle(args + " --steps 64", dir);
     EXPECT_EQ(r.status, 1) << args << ": " << r.out;

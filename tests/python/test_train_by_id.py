@@ -27,6 +27,12 @@ def test_train_by_id_on_every_family(tmp_path, env):
     assert result["steps"] == 1024
     assert os.path.exists(result["checkpoint"])
     assert [int(r["global_step"]) for r in rows(run)] == [128 * k for k in range(1, 9)]
+    # The trained policy's whole episodes, from seeds apart from training's.
+    evaluation = json.loads((run / "evaluation.json").read_text())
+    assert [e["seed"] for e in evaluation["episodes"]] == [1000, 1001]
+    assert evaluation["mean_return"] == pytest.approx(
+        sum(e["return"] for e in evaluation["episodes"]) / 2)
+    assert json.loads((run / "run.json").read_text())["env"] == cradle.env_spec(env).id
 
 
 def test_a_teacher_drives_a_teachmyagent_run(tmp_path):

@@ -55,7 +55,7 @@ TEST(RunEpisodes, StopsAtMaxStepsAsTruncated) {
   auto env = envs::make_env("sami/HalfCheetah", 0);
   const std::vector<std::uint64_t> seeds = {1, 2};
   const auto results = run_episodes(*env, constant(0.0), seeds, 25);
-  for (const EpisodeResult& r : results) {
+  for (const EpisodeOutcome& r : results) {
     EXPECT_EQ(r.length, 25);
     EXPECT_TRUE(r.truncated);
     EXPECT_FALSE(r.success);
