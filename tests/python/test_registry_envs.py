@@ -48,7 +48,7 @@ def test_specs_list_every_family_and_resolve_aliases():
     assert cradle.env_spec("sami/CrippleAnt").id == "sami/CrippleAnt:train"
     assert cradle.env_spec("BabyBench-SelfTouch").id == "babybench/selftouch"
     assert "stump_height" in cradle.env_spec("tma/stump-tracks:old_classic_bipedal").task_parameters
-    assert cradle.env_spec("sami/CrippleAnt:moderate").task_parameters == {"mass": (0.05, 5.0)}
+    assert cradle.env_spec("sami/CrippleAnt:moderate").task_parameters == {"mass": (0.05, 3.0)}
 
 
 # 100 random steps of every listed id (71 ids, about 25 s on two cores; the MIMo envs with eyes

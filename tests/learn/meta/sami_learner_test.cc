@@ -21,6 +21,7 @@
 #include "learn/grad_sync.h"
 #include "learn/hyperparams.h"
 #include "learn/meta/context_sac.h"
+#include "learn/networks.h"
 #include "learn/registry.h"
 #include "learn/test_tasks.h"
 #include "learn/vector_env.h"
@@ -250,6 +251,10 @@ TEST(SamiLearner, MatchesSamiTrainUpToTheFirstEpisodeEnd) {
       {"net_arch", "16"},           {"lstm_hidden", "4"},       {"batch_size", "3"},
       {"contrast_batch_size", "4"}, {"buffer_size", "2"},       {"train_freq", "10"},
       {"gradient_steps", "2"},      {"learning_starts", "100"}, {"adversarial_loss_coef", "1"}};
+  // LibTorch's and OpenBLAS's thread counts are process-wide and change float sums; a learner
+  // sets both to one (learn::apply_torch_options, as `cradle` does at start), so sami_train runs
+  // with one too, alone (ctest runs each test in its own process) as after the other tests.
+  learn::apply_torch_options({.torch_threads = 1});
   const auto dir = scratch("sami_train");
   train::sami_train({.env = "CrippleHalfCheetah",
                      .method = "SaCCM",
