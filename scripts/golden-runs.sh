@@ -34,9 +34,10 @@ cradle=$(realpath "$cradle")
 # actions on hand regard (the tasks' panels, traces and plots).
 cp -r "$out/ppo" "$out/eval_touch"
 "$cradle" evaluate --config "$config" --save-dir "$out/eval_touch" --episodes 2 --duration 40 \
-  --seed 3 --policy "$out/eval_touch/checkpoints/final.ckpt" >"$out/eval_touch.log" 2>&1
+  --seed 3 --render --policy "$out/eval_touch/checkpoints/final.ckpt" >"$out/eval_touch.log" 2>&1
 "$cradle" evaluate --config "$(dirname "$config")/config_handregard.yml" \
-  --save-dir "$out/eval_regard" --episodes 2 --duration 40 --seed 3 >"$out/eval_regard.log" 2>&1
+  --save-dir "$out/eval_regard" --episodes 2 --duration 40 --seed 3 --render \
+  >"$out/eval_regard.log" 2>&1
 # A TeachMyAgent student run (SAC + ALP-GMM) and SaMI runs, tiny budgets.
 "$cradle" tma run --env stump-tracks --embodiment old_classic_bipedal --student sac \
   --teacher ALP-GMM --nb_env_steps 0.004 --test_every 2000 --nb_test_episodes 3 --seed 3 \

@@ -1,5 +1,6 @@
 // `cradle evaluate --config FILE [--episodes 10] [--duration 1000] [--render | --no-render]
-// [--seed S] [--video-format mp4|avi]`: the reference's evaluation.py, with scores.
+// [--seed S] [--video-format mp4|avi]`: the reference's evaluation.py, with scores. Videos are
+// written with --render only (the reference films by default): a filmed frame costs 0.15-0.35 s.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -18,7 +19,7 @@ void register_evaluate(CLI::App& app) {
     std::string save_dir;
     int episodes = 10;
     int duration = 1000;
-    bool render = true;
+    bool render = false;
     std::uint64_t seed = 0;
     std::string format = "mp4";
     std::string policy;
@@ -28,7 +29,7 @@ void register_evaluate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "evaluate",
       "Score the training log, then run evaluation episodes (random or trained policy) and write "
-      "trajectories, videos, evaluation.json and plots under save_dir.\n"
+      "trajectories, evaluation.json, plots and, with --render, videos under save_dir.\n"
       "Scores: self-touch = (|geoms touched by right hand| + |by left hand|) / 68, unions over "
       "the last <= 10,000 logged episodes; hand regard = mean over the 4 eye-hand pairs of the "
       "fraction of steps in view (reference), and the mean over the eyes of the fraction with "
@@ -39,7 +40,10 @@ void register_evaluate(CLI::App& app) {
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--duration", opts->duration, "Env steps per episode")
       ->check(CLI::Range(1, 100000000));
-  cmd->add_flag("--render,!--no-render", opts->render, "Write a video per episode (default on)");
+  cmd->add_flag("--render,!--no-render", opts->render,
+                "Film every episode into videos/ (0.15-0.35 s a frame: minutes per episode); the "
+                "reference's evaluation.py films by default, --render does as it does. Default: "
+                "--no-render, no videos");
   cmd->add_option("--seed", opts->seed, "Seed: episode i resets with seed + i")->check(kSeed);
   CLI::Option* policy_option =
       cmd->add_option("--policy", opts->policy,
@@ -50,6 +54,9 @@ void register_evaluate(CLI::App& app) {
   cmd->add_option("--video-format", opts->format, "Video container")
       ->check(CLI::IsMember({"mp4", "avi"}));
   cmd->callback([opts] {
+    // One line per finished episode (its score and seconds): shown as it comes, also when stdout
+    // goes to a file or a pipe.
+    std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
     Config config = load_config(opts->config);
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
     train::EvaluationOptions options{.episodes = opts->episodes,

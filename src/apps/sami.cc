@@ -178,8 +178,9 @@ void register_learners(CLI::App& cmd) {
   tr->add_option("--method", opts->train.method, "TESAC, CCM, SaTESAC, SaCCM or SaCCMAll");
   tr->add_option("--seed", opts->train.seed, "Seed")->check(kSeed);
   tr->add_option("--steps-per-env", opts->train.steps_per_env,
-                 "Env steps per training env (default 500000; PandaPush 1000000)")
-      ->check(CLI::Range(1L, 10'000'000'000L));
+                 "Env steps per training env (default: the env's, 500000; PandaPush 1000000)")
+      ->check(CLI::Range(1L, 10'000'000'000L))
+      ->default_str("");  // 0 stands for the env's budget
   tr->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
   tr->add_option("--out", opts->out, "Run folder (default runs/sami/<env>_<method>_<seed>)");
   tr->add_flag("--resume", opts->train.resume, "Continue the run in --out from its checkpoint");

@@ -62,8 +62,10 @@ void register_soak(CLI::App& app) {
   cmd->add_option("--threads", opts->threads, "Worker threads (0: one per env, <= cores)")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--procs", opts->procs,
-                  "Run the envs in N worker processes (--envs a multiple of N) instead of threads")
-      ->check(CLI::Range(1, 1024));
+                  "Run the envs in N worker processes (--envs a multiple of N) instead of threads "
+                  "(default: threads)")
+      ->check(CLI::Range(1, 1024))
+      ->default_str("");  // 0 stands for threads
   cmd->add_option("--eval-every", opts->eval_every,
                   "Env steps between evaluations run beside the live vector")
       ->check(CLI::Range(1L, 100000000000L));

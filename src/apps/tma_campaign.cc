@@ -1027,12 +1027,19 @@ void register_tma_campaign(CLI::App& tma) {
   gen->add_option("--teacher", go->teacher, "Teacher (Random, ADR, ALP-GMM, RIAC, ...)")
       ->required();
   gen->add_option("--teacher-param", go->teacher_params, "Teacher parameter key=value");
+  // Left out, these three take the preset's value: --help names it instead of the placeholder.
   gen->add_option("--test-episodes", go->test_episodes,
-                  "0: the reference's test sets (paper); N: N default test tasks (mini 10)")
-      ->check(CLI::Range(0, 100000));
-  gen->add_option("--steps", go->steps, "Env steps per run, millions (paper 20, mini 0.02)");
-  gen->add_option("--seeds", go->seeds, "Seeds per configuration (paper 16, mini 2)")
-      ->check(CLI::Range(1, 100000));
+                  "0: the reference's test sets; N: N default test tasks (default: the "
+                  "preset's, paper 0, mini 10)")
+      ->check(CLI::Range(0, 100000))
+      ->default_str("");
+  gen->add_option("--steps", go->steps,
+                  "Env steps per run, millions (default: the preset's, paper 20, mini 0.02)")
+      ->default_str("");
+  gen->add_option("--seeds", go->seeds,
+                  "Seeds per configuration (default: the preset's, paper 16, mini 2)")
+      ->check(CLI::Range(1, 100000))
+      ->default_str("");
   gen->add_option("--preset", go->preset, "paper | mini");
   gen->add_option("--out", go->out, "Write here (default: stdout)");
   gen->callback([go, gen] {
@@ -1049,13 +1056,13 @@ void register_tma_campaign(CLI::App& tma) {
   auto lo = std::make_shared<LaunchOptions>();
   CLI::App* lau = campaign->add_subcommand("launch", "Run a campaign file (Slurm or locally)");
   lau->add_option("FILE", lo->file, "Campaign file")->required();
-  lau->add_option("--results", lo->results, "Results tree (default tma_results)");
+  lau->add_option("--results", lo->results, "Results tree");
   lau->add_option("--jobs", lo->jobs, "Local: runs at once");
   lau->add_flag("--dry-run", lo->dry_run, "Print the sbatch scripts (or local commands) only");
   lau->add_flag("--resume", lo->resume, "Skip finished seeds, continue the others");
   lau->add_flag("--local", lo->local, "Local process pool even where sbatch exists");
   lau->add_flag("--slurm", lo->slurm, "Slurm (an error where sbatch is missing, but --dry-run)");
-  lau->add_option("--seeds-per-job", lo->seeds_per_job, "Slurm: seeds per array task (8)")
+  lau->add_option("--seeds-per-job", lo->seeds_per_job, "Slurm: seeds per array task")
       ->check(CLI::Range(1, 1024));
   lau->add_option("--sbatch", lo->sbatch_args, "Slurm: extra #SBATCH line, e.g. --time=20:00:00");
   lau->add_flag("--wait", lo->wait, "Slurm: wait until every job has left the queue");

@@ -127,7 +127,7 @@ TEST(Cli, TestInstallationWritesSceneLogAndVideo) {
 }
 
 // A random baseline writes a log; evaluate, run from another working directory, scores it and
-// writes trajectories, videos, evaluation.json and plots.
+// writes trajectories, videos (--render), evaluation.json and plots.
 TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
   const fs::path dir = temp_dir("eval");
   cradle::test::self_touch_config(dir, 50, "touch_function: force_vector\n");
@@ -138,7 +138,7 @@ TEST(Cli, RandomThenEvaluateFromAnotherDirectory) {
   const fs::path elsewhere = dir / "elsewhere";
   fs::create_directories(elsewhere);
   const CliResult evaluated =
-      run_cradle("evaluate --config ../config.yml --episodes 2 --duration 30", elsewhere);
+      run_cradle("evaluate --config ../config.yml --episodes 2 --duration 30 --render", elsewhere);
   ASSERT_EQ(evaluated.status, 0) << evaluated.out;
   const fs::path run = dir / "run";
   for (const char* file :

@@ -123,11 +123,17 @@ def test_docs_have_runnable_blocks():
 
 
 def subcommands(*words):
-    """The subcommand names `cradle WORDS... --help` lists."""
+    """The subcommand names `cradle WORDS... --help` lists: the entries of every heading but
+    Options and Positionals (`cradle --help` groups them: Envs, Train, ...)."""
     text = subprocess.run([cradle_binary(), *words, "--help"], capture_output=True, text=True,
                           check=True).stdout
-    listed = text.split("Subcommands:", 1)[1] if "Subcommands:" in text else ""
-    return re.findall(r"(?m)^  (\S+)\s", listed)
+    names, heading = [], None
+    for line in text.splitlines():
+        if re.match(r"^\S.*:$", line):
+            heading = line[:-1]
+        elif heading not in (None, "Options", "Positionals") and re.match(r"^  \S", line):
+            names.append(line.split()[0])
+    return names
 
 
 def test_cli_reference_has_every_subcommand():
