@@ -89,11 +89,14 @@ void register_train(CLI::App& app) {
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--procs", opts->train.procs,
                   "Run the envs in N worker processes (--envs a multiple of N): envs that render "
-                  "draw in parallel")
-      ->check(CLI::Range(1, 1024));
+                  "draw in parallel (default: threads)")
+      ->check(CLI::Range(1, 1024))
+      ->default_str("");
   cmd->add_option("--async-batch", opts->train.async_batch,
-                  "PPO/A2C: collect asynchronously in batches of the first K envs (K < --envs)")
-      ->check(CLI::Range(1, 1024));
+                  "PPO/A2C: collect asynchronously in batches of the first K envs (K < --envs; "
+                  "default: lock-step)")
+      ->check(CLI::Range(1, 1024))
+      ->default_str("");
   cmd->add_option(
          "--update-threads", opts->train.update_threads,
          "LibTorch threads for gradient updates (0: every core for image policies, 1 otherwise)")
