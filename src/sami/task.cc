@@ -233,6 +233,26 @@ std::vector<std::array<double, 2>> panda_cells(Split split) {
   return {};
 }
 
+std::vector<TaskSet> one_set_per_env(std::vector<TaskSet> sets) {
+  if (sets.size() != 1) return sets;
+  const TaskSet& one = sets[0];
+  std::vector<TaskSet> out;
+  if (one.cripple.size() > 1) {
+    for (const auto& choice : one.cripple) {
+      TaskSet s = one;
+      s.cripple = {choice};
+      out.push_back(s);
+    }
+  } else if (one.mass.size() > 1) {
+    for (double m : one.mass) {
+      TaskSet s = one;
+      s.mass = {m};
+      out.push_back(s);
+    }
+  }
+  return out.empty() ? sets : out;
+}
+
 std::vector<TaskSet> split_sets(EnvId id, Split split) {
   const int s = static_cast<int>(split);
   switch (id) {

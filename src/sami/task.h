@@ -75,6 +75,10 @@ Split split_from_name(std::string_view name);
 std::vector<TaskSet> split_sets(EnvId id, Split split);
 // The split a name selects, or the task sets of a YAML file when `name` ends in .yml / .yaml.
 std::vector<TaskSet> task_sets(EnvId id, std::string_view split_or_file);
+// The sets of a vector, one sub-env each (SaMI's DummyVecEnv): `sets` as they are, except that a
+// single set that varies its crippling (or else its mass) is split into one set per choice, so
+// that the methods that contrast envs have more than one.
+std::vector<TaskSet> one_set_per_env(std::vector<TaskSet> sets);
 // Task sets from a YAML file: `task_sets: [{mass: [..], damping: [..], cripple: [[..]], mask: b,
 // cells: [[friction, mass]]}]`. Throws UserError naming the file and the set for anything wrong
 // (a missing file or a folder, bad YAML, an unknown or repeated key, what validate() refuses).

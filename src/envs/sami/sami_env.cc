@@ -73,24 +73,7 @@ StepResult SamiEnvAdapter::step(std::span<const double> action) {
 }
 
 std::vector<sami::TaskSet> sami_vector_sets(sami::EnvId id, std::string_view split_or_file) {
-  std::vector<sami::TaskSet> sets = sami::task_sets(id, split_or_file);
-  if (sets.size() != 1) return sets;
-  const sami::TaskSet one = sets[0];
-  std::vector<sami::TaskSet> out;
-  if (one.cripple.size() > 1) {
-    for (const auto& choice : one.cripple) {
-      sami::TaskSet s = one;
-      s.cripple = {choice};
-      out.push_back(s);
-    }
-  } else if (one.mass.size() > 1) {
-    for (double m : one.mass) {
-      sami::TaskSet s = one;
-      s.mass = {m};
-      out.push_back(s);
-    }
-  }
-  return out.empty() ? sets : out;
+  return sami::one_set_per_env(sami::task_sets(id, split_or_file));
 }
 
 std::unique_ptr<Env> make_sami_env(std::string_view name, std::string_view split,

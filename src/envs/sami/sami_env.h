@@ -43,9 +43,8 @@ class SamiEnvAdapter final : public Env {
   std::vector<sami::TaskSet> base_sets_;  // the sets the env was made with
 };
 
-// The task sets of a vector of SaMI envs, one per env (SaMI's DummyVecEnv): the split's (or YAML
-// file's) sets, where a single set that varies its crippling (or else its mass) is split into one
-// set per choice so that the methods that contrast envs have more than one.
+// The task sets of a vector of SaMI envs, one per env: the split's (or YAML file's) sets through
+// sami::one_set_per_env.
 std::vector<sami::TaskSet> sami_vector_sets(sami::EnvId id, std::string_view split_or_file);
 
 // A SaMI env by name and split (or task-set YAML file) behind the Env interface.

@@ -91,24 +91,7 @@ std::string cell_name(const sami::TaskSet& set, bool panda) {
 }  // namespace
 
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id) {
-  std::vector<sami::TaskSet> sets = sami::split_sets(id, sami::Split::kTrain);
-  if (sets.size() != 1) return sets;
-  const sami::TaskSet one = sets[0];
-  std::vector<sami::TaskSet> out;
-  if (one.cripple.size() > 1) {
-    for (const auto& choice : one.cripple) {
-      sami::TaskSet s = one;
-      s.cripple = {choice};
-      out.push_back(s);
-    }
-  } else if (one.mass.size() > 1) {
-    for (double m : one.mass) {
-      sami::TaskSet s = one;
-      s.mass = {m};
-      out.push_back(s);
-    }
-  }
-  return out.empty() ? sets : out;
+  return sami::one_set_per_env(sami::split_sets(id, sami::Split::kTrain));
 }
 
 SamiRunFile read_sami_run(const std::filesystem::path& run) {
@@ -220,8 +203,8 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   envs.reset(seed + static_cast<std::uint64_t>(steps));
   ContextSac::Streams streams = learner.streams(n);
   for (int i = 0; i < n; ++i) {
-    replay.begin(i, envs.observations().subspan(static_cast<size_t>(i) * spec.obs_size,
-                                                spec.obs_size));
+    replay.begin(
+        i, envs.observations().subspan(static_cast<size_t>(i) * spec.obs_size, spec.obs_size));
   }
 
   // Report accumulators.

@@ -17,9 +17,7 @@
 
 namespace cradle::train {
 
-// The training task sets, one sub-env each (SaMI's DummyVecEnv). A split with a single set that
-// varies its crippling (or else its mass) is split into one set per choice, so that the methods
-// that contrast envs have more than one.
+// The training task sets, one sub-env each (sami::one_set_per_env of the train split).
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id);
 
 struct SamiTrainOptions {
