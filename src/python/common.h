@@ -58,6 +58,11 @@ auto without_gil(Work&& work) {
   return work();
 }
 
+// Actions as Python passes them (any sequence of numbers, converted to contiguous doubles).
+using Actions = py::array_t<double, py::array::c_style | py::array::forcecast>;
+// Checks the action's size (ValueError) and steps the env with the GIL released.
+envs::StepResult step_without_gil(envs::Env& env, const Actions& action);
+
 // Parses a config from YAML text (dicts arrive as JSON, a YAML subset); UserError -> ValueError.
 Config config_from_text(const std::string& text, const std::string& source);
 

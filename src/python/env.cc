@@ -126,18 +126,8 @@ class PyEnv {
     return py::make_tuple(observation(), info());
   }
 
-  py::tuple step(const py::array_t<double, py::array::c_style | py::array::forcecast>& action) {
-    const py::ssize_t n = env_->action_space().size();
-    if (action.size() != n) {
-      throw py::value_error("action has " + std::to_string(action.size()) + " values, expected " +
-                            std::to_string(n));
-    }
-    const std::span<const double> a(action.data(), static_cast<size_t>(n));
-    envs::StepResult r;
-    {
-      py::gil_scoped_release release;
-      r = env_->step(a);
-    }
+  py::tuple step(const Actions& action) {
+    const envs::StepResult r = step_without_gil(*env_, action);
     return py::make_tuple(observation(), r.reward, r.terminated, r.truncated, info());
   }
 

@@ -73,6 +73,16 @@ py::dict info_dict(const envs::Info& info) {
   return d;
 }
 
+envs::StepResult step_without_gil(envs::Env& env, const Actions& action) {
+  const py::ssize_t n = env.action_space().size();
+  if (action.size() != n) {
+    throw py::value_error("action has " + std::to_string(action.size()) + " values, expected " +
+                          std::to_string(n));
+  }
+  const std::span<const double> a(action.data(), static_cast<size_t>(n));
+  return without_gil([&] { return env.step(a); });
+}
+
 py::tuple box_tuple(const Box& box) {
   py::tuple shape(box.shape.size());
   for (size_t i = 0; i < box.shape.size(); ++i) shape[i] = box.shape[i];

@@ -26,8 +26,6 @@
 namespace cradle::python {
 namespace {
 
-using Actions = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
 // Raises NotImplementedError with `message`.
 [[noreturn]] void not_implemented(const std::string& message) {
   PyErr_SetString(PyExc_NotImplementedError, message.c_str());
@@ -70,17 +68,7 @@ class PyRegistryEnv {
   }
 
   py::tuple step(const Actions& action) {
-    const py::ssize_t n = env_->action_space().size();
-    if (action.size() != n) {
-      throw py::value_error("action has " + std::to_string(action.size()) + " values, expected " +
-                            std::to_string(n));
-    }
-    const std::span<const double> a(action.data(), static_cast<size_t>(n));
-    envs::StepResult r;
-    {
-      py::gil_scoped_release release;
-      r = env_->step(a);
-    }
+    const envs::StepResult r = step_without_gil(*env_, action);
     return py::make_tuple(observation(), r.reward, r.terminated, r.truncated, info());
   }
 
