@@ -155,7 +155,8 @@ struct RunOptions {
   long test_every = 500000, keep_periodical_task_samples = 0, reset_frequency = 0;
   int nb_test_episodes = 100;
   std::uint64_t seed = 0;
-  bool shuffle_dimensions = false, scale_reward = false, resume = false, no_progress = false;
+  bool shuffle_dimensions = false, scale_reward = false, resume = false, overwrite = false,
+       no_progress = false;
   EnvFlags env_flags;
 };
 
@@ -333,6 +334,7 @@ void register_tma(CLI::App& app) {
   run->add_option("--hp", rn->hp, "Student hyperparameter override name=value (repeatable)");
   run->add_option("--out", rn->out, "Run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)");
   run->add_flag("--resume", rn->resume, "Continue the run in --out from its last checkpoint");
+  run->add_flag("--overwrite", rn->overwrite, "Replace the run already in --out");
   run->add_flag("--no-progress", rn->no_progress, "No progress bar");
   run->callback([rn] {
     const RunOptions& ro = *rn;
@@ -362,6 +364,7 @@ void register_tma(CLI::App& app) {
                                .scale_reward = ro.scale_reward,
                                .reset_frequency = ro.reset_frequency,
                                .resume = ro.resume,
+                               .overwrite = ro.overwrite,
                                .progress_bar = !ro.no_progress};
     for (const std::string& kv : ro.teacher_params) {
       const auto [k, v] = key_value("--teacher-param", kv);

@@ -8,13 +8,15 @@ namespace cradle::train {
 
 std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
                                          std::span<const std::uint64_t> seeds, int max_steps,
-                                         const EpisodeStepFn& on_step) {
+                                         const EpisodeStepFn& on_step,
+                                         const EpisodeStartFn& on_start) {
   std::vector<double> action(env.action_space().size());
   const int success = env.info().find("is_success");
   const int failure = env.info().find("is_failure");
   std::vector<EpisodeOutcome> out;
   for (size_t e = 0; e < seeds.size(); ++e) {
     EpisodeOutcome r{.seed = seeds[e]};
+    if (on_start) on_start(static_cast<int>(e), env);
     env.reset(seeds[e]);
     if (policy.new_episode) policy.new_episode();
     while (true) {

@@ -33,11 +33,15 @@ struct EpisodePolicy {
 // Called after every step (e.g. to film or trace), with the episode's index.
 using EpisodeStepFn = std::function<void(int episode, const envs::Env&, const envs::StepResult&)>;
 
+// Called before each episode's reset (e.g. to set the episode's task as reset options).
+using EpisodeStartFn = std::function<void(int episode, envs::Env&)>;
+
 // Plays one episode per seed on `env` (reset with that seed) until it terminates or truncates,
 // or after max_steps steps when max_steps > 0 (then counted as truncated).
 std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
                                          std::span<const std::uint64_t> seeds, int max_steps = 0,
-                                         const EpisodeStepFn& on_step = nullptr);
+                                         const EpisodeStepFn& on_step = nullptr,
+                                         const EpisodeStartFn& on_start = nullptr);
 
 // The results as evaluation.json writes them: per episode, then mean and std of the return,
 // the mean length and the success rate.

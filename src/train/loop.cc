@@ -39,27 +39,38 @@ void ProgressBar::finish() const {
 }
 
 long run_loop(learn::Learner& learner, const LoopOptions& options) {
+  return run_loop([&learner]() -> learn::Learner& { return learner; }, options);
+}
+
+long run_loop(const std::function<learn::Learner&()>& current, const LoopOptions& options) {
   const long every = options.boundary_every;
-  auto next_boundary = [&] { return every > 0 ? (learner.steps() / every + 1) * every : -1; };
+  const bool exact = static_cast<bool>(options.next_boundary);
+  auto offset = [&] { return options.offset ? options.offset() : 0L; };
+  auto steps = [&] { return offset() + current().steps(); };
+  auto next_boundary = [&] {
+    if (exact) return options.next_boundary(steps());
+    return every > 0 ? (steps() / every + 1) * every : -1L;
+  };
   auto stopping = [&] { return options.stopping && options.stopping(); };
   long boundary = next_boundary();
   bool stop = false;  // a report said stop
   // One learn() call per interval between boundaries.
-  while (learner.steps() < options.total_steps && !stop && !stopping()) {
-    const long before = learner.steps();
-    learner.learn(options.total_steps, [&](const learn::TrainStats& s) {
+  while (steps() < options.total_steps && !stop && !stopping()) {
+    const long before = steps();
+    const long off = offset();
+    const long target = exact ? std::min(boundary, options.total_steps) : options.total_steps;
+    current().learn(target - off, [&](const learn::TrainStats& s) {
       if (options.report && !options.report(s)) {
         stop = true;
         return false;
       }
-      return (boundary < 0 || s.steps < boundary) && !stopping();
+      return (exact || boundary < 0 || off + s.steps < boundary) && !stopping();
     });
-    if (boundary >= 0 && learner.steps() >= boundary && learner.steps() < options.total_steps &&
-        !stop) {
+    if (boundary >= 0 && steps() >= boundary && steps() < options.total_steps && !stop) {
       if (options.at_boundary) options.at_boundary();
       boundary = next_boundary();
     }
-    if (learner.steps() == before) break;  // a learner that cannot advance
+    if (steps() == before) break;  // a learner that cannot advance
   }
   return boundary;
 }

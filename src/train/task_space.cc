@@ -2,11 +2,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <climits>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/jsonl.h"
 #include "teach/registry.h"
+#include "train/run_json.h"
 
 namespace cradle::train {
 namespace {
@@ -135,6 +139,79 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
                                .reward_lb = spec.reward_lb,
                                .reward_ub = spec.reward_ub,
                                .test_set = teach::default_test_set(*spec.space, 1)});
+}
+
+namespace {
+
+// Checks every line of a teacher book, then (with a controller) replays it.
+void read_teacher_book(teach::TeacherController* controller, const std::filesystem::path& file,
+                       bool periodical, std::size_t dims) {
+  const std::string what = "a line of a run's teacher book";
+  const std::string dim_text = "a task of " + std::to_string(dims) + " numbers";
+  // Every line checked before the controller hears any (never a half-replayed teacher).
+  std::vector<teach::EpisodeRecord> episodes;
+  std::vector<teach::PeriodicalRecord> samples;
+  std::vector<int> order;  // 0: the next episode, 1: the next periodical sample
+  // read_jsonl names the file and line of a problem; `where` names the part of the line.
+  read_jsonl(file, [&](const nlohmann::json& entry) -> std::string {
+    try {
+      const RunJson line("the line", entry, what);
+      const std::string kind = line.string("kind");
+      if (kind == "train") {
+        teach::EpisodeRecord e{
+            .env_steps = line.count("env_steps"),
+            .task = line.floats("task"),
+            .ret = line.number("return"),
+            .length = static_cast<int>(std::min<long>(line.count("length"), INT_MAX)),
+            .success = line.boolean("success")};
+        if (e.task.size() != dims)
+          throw UserError(line.where() + ": \"task\" has " + std::to_string(e.task.size()) +
+                          " numbers; expected " + dim_text);
+        episodes.push_back(std::move(e));
+        order.push_back(0);
+      } else if (kind == "periodical") {
+        teach::PeriodicalRecord p{.env_steps = line.count("env_steps")};
+        if (!line.json()["tasks"].is_array())
+          throw UserError(line.where() + ": \"tasks\" is not a list; expected a list of tasks");
+        for (const nlohmann::json& t : line.json()["tasks"]) {
+          const RunJson task(line.where() + ": tasks", {{"task", t}}, what);
+          p.tasks.push_back(task.floats("task"));
+          if (p.tasks.back().size() != dims)
+            throw UserError(line.where() + ": a periodical task is not " + dim_text);
+        }
+        samples.push_back(std::move(p));
+        order.push_back(1);
+      } else if (kind != "dump") {
+        throw UserError(line.where() + ": \"kind\" is \"" + kind +
+                        "\"; expected train, periodical or dump");
+      }
+    } catch (const UserError& e) {
+      return e.what();
+    }
+    return "";
+  });
+  if (!controller) return;
+  std::size_t next_episode = 0, next_sample = 0;
+  for (int kind : order) {
+    if (kind == 0) {
+      const teach::EpisodeRecord& e = episodes[next_episode++];
+      controller->replay_train_episode(e.task, e.ret, e.length, e.success, e.env_steps);
+    } else if (periodical) {
+      controller->replay_periodical(std::move(samples[next_sample++]));
+    }
+  }
+}
+
+}  // namespace
+
+void check_teacher_book(const std::filesystem::path& file, int dims) {
+  read_teacher_book(nullptr, file, false, static_cast<std::size_t>(dims));
+}
+
+void replay_teacher_book(teach::TeacherController& controller, const std::filesystem::path& file,
+                         bool periodical) {
+  read_teacher_book(&controller, file, periodical,
+                    static_cast<std::size_t>(controller.space().dims()));
 }
 
 }  // namespace cradle::train

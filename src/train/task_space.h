@@ -60,4 +60,14 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
                                                           std::unique_ptr<teach::Teacher> teacher,
                                                           std::uint64_t seed);
 
+// A resumed run's teacher hears its book (the run's teacher.jsonl) again, in order: the training
+// episodes and, with `periodical`, the periodical task samples; teacher dumps are skipped. Every
+// line is checked first (its kind, a task of the controller's dimension, the types of return,
+// length, success and env_steps): a damaged line is a one-line UserError naming file, line and key,
+// and the controller hears nothing.
+void replay_teacher_book(teach::TeacherController& controller, const std::filesystem::path& file,
+                         bool periodical);
+// The same checks alone, for a task space of `dims` dimensions (before a resume changes any file).
+void check_teacher_book(const std::filesystem::path& file, int dims);
+
 }  // namespace cradle::train

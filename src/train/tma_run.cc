@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/jsonl.h"
+#include "core/sealed_file.h"
 #include "envs/tma/tma_env.h"
 #include "learn/learner.h"
 #include "learn/registry.h"
@@ -17,7 +18,10 @@
 #include "learn/vector_env.h"
 #include "tma/cppn.h"
 #include "train/curriculum_env.h"
+#include "train/episodes.h"
 #include "train/loop.h"
+#include "train/run_json.h"
+#include "train/task_space.h"
 
 namespace cradle::train {
 namespace {
@@ -33,29 +37,6 @@ const char* const kTestHeader = "evaluation,env_steps,task_index,return,mastered
 const char* const kLogs[] = {"progress.csv", "test_returns.csv", "teacher.jsonl"};
 // Arguments a resumed run may change.
 const char* const kResumable[] = {"nb_env_steps", "test_every", "resume", "out", "progress_bar"};
-
-// Writes `text` to `file` through a temp file and a rename (never half a file).
-void write_atomically(const fs::path& file, const std::string& text) {
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << text;
-    if (!out.flush()) throw UserError("cannot write '" + tmp.string() + "'");
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) throw UserError("cannot write '" + file.string() + "': " + ec.message());
-}
-
-nlohmann::json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw UserError("--resume: cannot read '" + file.string() + "'");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception&) {
-    throw UserError("--resume: '" + file.string() + "' is not valid JSON");
-  }
-}
 
 // Cuts `file` back to `size` bytes; what follows goes to <stem>.after-checkpoint<ext>.
 void cut_back(const fs::path& file, std::uintmax_t size) {
@@ -95,12 +76,13 @@ std::vector<std::string> split_cells(const std::string& line) {
 }
 
 // A log written by a binary with other columns (an older one: fewer) under the current `header`.
-// When every old column is among the current ones, the file is rewritten in place: each row's
-// cells move under their column's name and the columns the old binary lacked stay empty, so one
-// CSV holds the whole run and nothing is lost. Otherwise (a column would be dropped, or a row
-// does not fit its header) the file is kept whole as <stem>.before-resume[-k]<ext> and a fresh
-// one begins. Returns whether the file still needs its header (kept aside or missing); prints one
-// line when it changed anything.
+// Each row's cells move under their column's name, the columns the old binary lacked stay empty,
+// and the file is rewritten in place, so one CSV holds the whole run and its evaluation numbering
+// goes on. When a column of the old file has no place in the current header, the old file is also
+// kept whole as <stem>.before-resume[-k]<ext>. A row that does not fit its header (a damaged file)
+// cannot be carried over: the file is then kept whole aside and a fresh one begins. Returns
+// whether the file still needs its header (kept aside or missing); prints one line when it
+// changed anything.
 bool adopt_header(const fs::path& file, const std::string& header) {
   std::ifstream in(file);
   std::string first;
@@ -108,38 +90,47 @@ bool adopt_header(const fs::path& file, const std::string& header) {
   if (first == header) return false;
   const std::vector<std::string> now = split_cells(header), old = split_cells(first);
   std::vector<int> where(old.size(), -1);  // each old column's index in the current header
-  bool fits = true;
+  bool dropped = false;
   for (std::size_t c = 0; c < old.size(); ++c) {
     const auto it = std::find(now.begin(), now.end(), old[c]);
     if (it == now.end())
-      fits = false;
+      dropped = true;
     else
       where[c] = static_cast<int>(it - now.begin());
   }
   std::ostringstream text;
   text << header << "\n";
-  for (std::string line; fits && std::getline(in, line);) {
+  bool fits = true;
+  for (std::string line; std::getline(in, line);) {
     const std::vector<std::string> cells = split_cells(line);
     if (cells.size() != old.size()) {
       fits = false;
       break;
     }
     std::vector<std::string> row(now.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) row[where[c]] = cells[c];
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      if (where[c] >= 0) row[where[c]] = cells[c];
     for (std::size_t c = 0; c < row.size(); ++c) text << (c ? "," : "") << row[c];
     text << "\n";
   }
   in.close();
-  if (fits) {
-    write_atomically(file, text.str());
-    std::cerr << file.filename().string() << ": rows of an older header rewritten under the "
-              << "current one (new columns empty)\n";
-    return false;
+  const std::string name = file.filename().string();
+  if (!fits) {
+    const fs::path kept = learn::keep_aside_before_resume(file);
+    std::cerr << name << ": a row does not fit its header; the file is kept as " << kept.string()
+              << " and a fresh one begins\n";
+    return true;
   }
-  const fs::path kept = learn::keep_aside_before_resume(file);
-  std::cerr << file.filename().string() << ": written with other columns, kept as " << kept.string()
-            << "\n";
-  return true;
+  if (dropped) {
+    fs::path kept = learn::keep_aside_before_resume(file);
+    std::cerr << name << ": written with other columns, kept whole as " << kept.string()
+              << "; its rows go on under the current header (unknown columns left out)\n";
+  } else {
+    std::cerr << name << ": rows of an older header rewritten under the current one (new columns "
+              << "empty)\n";
+  }
+  write_atomically(file, text.str());
+  return false;
 }
 
 // The teacher's build: the registry's setup from the run's options and the env's facts.
@@ -242,6 +233,54 @@ std::map<std::string, std::string> student_preset(const std::string& student, lo
   throw UserError("--student '" + student + "' (expected sac or ppo)");
 }
 
+namespace {
+
+// The resume point of a run: checkpoints/latest.json, every key checked.
+struct ResumePoint {
+  long env_steps = 0, learner_steps = 0, step_offset = 0, episodes = 0;
+  int student_resets = 0, evaluation = 0;
+  double wall_s = 0;
+  std::map<std::string, std::uintmax_t> sizes;  // of kLogs
+};
+
+ResumePoint read_resume_point(const fs::path& file) {
+  const RunJson j(file, "the resume point of a `cradle tma run` run (checkpoints/latest.json)");
+  ResumePoint p{.env_steps = j.count("env_steps"),
+                .learner_steps = j.count("learner_steps"),
+                .step_offset = j.count("step_offset"),
+                .episodes = j.count("episodes"),
+                .student_resets = static_cast<int>(std::min(j.count("student_resets"), 1L << 30)),
+                .evaluation = static_cast<int>(std::min(j.count("evaluation"), 1L << 30)),
+                .wall_s = j.number("wall_s")};
+  const RunJson sizes = j.object("sizes");
+  for (const char* name : kLogs) p.sizes[name] = sizes.unsigned_integer(name);
+  return p;
+}
+
+// The checkpoint a resume point names: checkpoints/step_<env_steps>.ckpt (latest.ckpt in folders
+// of builds that wrote no step file).
+fs::path resume_checkpoint(const fs::path& checkpoints, long env_steps) {
+  const fs::path step = checkpoints / ("step_" + std::to_string(env_steps) + ".ckpt");
+  return fs::exists(step) ? step : checkpoints / "latest.ckpt";
+}
+
+// Makes `folder` (and its parents): a one-line UserError naming it when that fails.
+void make_folder(const fs::path& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec || !fs::is_directory(folder)) {
+    throw UserError("cannot create the run folder '" + folder.string() +
+                    "': " + (ec ? ec.message() : "a file of that name is in the way"));
+  }
+}
+
+// The files a run writes in its folder (removed by --overwrite).
+const char* const kRunFiles[] = {"run.json",     "progress.csv",  "test_returns.csv",
+                                 "test_set.csv", "teacher.jsonl", "summary.json",
+                                 "checkpoints"};
+
+}  // namespace
+
 StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) {
   // Options first: nothing is written for a bad one.
   if (o.total_steps < 1) throw UserError("--nb_env_steps must give at least 1 env step");
@@ -249,6 +288,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   if (o.nb_test_episodes < 1) throw UserError("--nb_test_episodes must be at least 1");
   if (o.reset_frequency < 0) throw UserError("--reset_frequency must be >= 0 (0: never)");
   if (o.out.empty()) throw UserError("--out: no run folder given");
+  if (o.resume && o.overwrite) throw UserError("--resume and --overwrite: give one of them");
   std::map<std::string, std::string> hyperparameters = student_preset(o.student, o.total_steps);
   for (const auto& [k, v] : o.hyperparameters) hyperparameters[k] = v;
 
@@ -256,6 +296,23 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   const fs::path checkpoints = dir / "checkpoints";
   const fs::path latest = checkpoints / "latest.ckpt";
   const fs::path state_file = checkpoints / "latest.json";
+  // A folder that holds a run is continued (--resume) or replaced (--overwrite), never silently.
+  {
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+      throw UserError("--out '" + dir.string() + "' is a file; expected a run folder");
+    }
+    const bool holds_run = fs::exists(dir / "run.json", ec) ||
+                           fs::exists(dir / "progress.csv", ec) || fs::exists(state_file, ec);
+    if (holds_run && !o.resume && !o.overwrite) {
+      throw UserError("--out '" + dir.string() +
+                      "' holds a run; give --resume to continue it, --overwrite to replace it, or "
+                      "another folder");
+    }
+    if (o.overwrite) {
+      for (const char* name : kRunFiles) fs::remove_all(dir / name, ec);
+    }
+  }
   nlohmann::ordered_json run_json;
   run_json["arguments"] = o.arguments;
   run_json["student"] = o.student;
@@ -314,30 +371,37 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   controller->teacher().set_value_estimator(learner_value_estimator(
       [&learner]() -> learn::Learner& { return *learner; }, vec.observation_space()));
 
-  // Resume: the same arguments (but the resumable ones), the checkpoint's state.
-  nlohmann::json state;
+  // Resume: the same arguments (but the resumable ones), the resume point's checkpoint, every
+  // file checked before anything is cut or changed.
+  ResumePoint state;
+  fs::path resume_from;
   if (o.resume) {
-    if (!fs::exists(latest) || !fs::exists(state_file)) {
+    if (!fs::exists(state_file)) {
       throw UserError("--resume: no checkpoint in '" + checkpoints.string() + "'");
     }
-    const nlohmann::json saved = read_json(dir / "run.json");
+    const RunJson saved(dir / "run.json", "the run.json of a `cradle tma run` run");
+    const RunJson saved_arguments = saved.object("arguments");
     for (const auto& [key, value] : o.arguments.items()) {
       if (std::find(std::begin(kResumable), std::end(kResumable), key) != std::end(kResumable))
         continue;
-      const nlohmann::json before = saved["arguments"].value(key, nlohmann::json());
+      const nlohmann::json before = saved_arguments.json().value(key, nlohmann::json());
       if (before != nlohmann::json::parse(value.dump())) {
         throw UserError("--resume: --" + key + " is " + value.dump() + " but the run had " +
                         before.dump() + " (give the run's arguments again)");
       }
     }
-    state = read_json(state_file);
-    if (learn::load_run_state(latest, nullptr).steps != state.value("learner_steps", -1L)) {
-      throw UserError("--resume: '" + latest.string() + "' and '" + state_file.string() +
+    state = read_resume_point(state_file);
+    resume_from = resume_checkpoint(checkpoints, state.env_steps);
+    if (learn::load_run_state(resume_from, nullptr).steps != state.learner_steps) {
+      throw UserError("--resume: '" + resume_from.string() + "' and '" + state_file.string() +
                       "' are of different steps");
     }
-    for (const char* name : kLogs) cut_back(dir / name, state["sizes"][name].get<std::uintmax_t>());
+    // The teacher's book is checked whole before the logs are cut back to the checkpoint.
+    check_teacher_book(dir / "teacher.jsonl", env.space.dims());
+    for (const char* name : kLogs) cut_back(dir / name, state.sizes[name]);
   } else {
-    fs::create_directories(checkpoints);
+    make_folder(dir);
+    make_folder(checkpoints);
   }
   write_atomically(dir / "run.json", run_json.dump(2) + "\n");
 
@@ -355,42 +419,34 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     write_atomically(dir / "test_set.csv", csv.str());
   }
   // A resumed teacher hears the booked episodes again, in order.
-  if (o.resume) {
-    for (const nlohmann::json& line : read_jsonl(dir / "teacher.jsonl")) {
-      const std::string kind = line.value("kind", "");
-      if (kind == "train") {
-        controller->replay_train_episode(line["task"].get<teach::Task>(), line["return"],
-                                         line["length"], line["success"], line["env_steps"]);
-      } else if (kind == "periodical") {
-        controller->replay_periodical({.env_steps = line["env_steps"],
-                                       .tasks = line["tasks"].get<std::vector<teach::Task>>()});
-      }
-    }
-  }
+  if (o.resume) replay_teacher_book(*controller, dir / "teacher.jsonl", /*periodical=*/true);
 
   if (o.resume) {
-    offset = state["step_offset"].get<long>();
-    student_resets = state["student_resets"].get<int>();
+    offset = state.step_offset;
+    student_resets = state.student_resets;
     if (student_resets > 0) learner = make_student();
-    learner->load(latest);
+    learner->load(resume_from);
   }
   auto run_steps = [&] { return offset + learner->steps(); };
 
   // The logs: appended to on resume (already cut back; an older binary's columns adopted, and
-  // the checkpoint's sizes then follow the rewritten files), fresh otherwise.
+  // the resume point's sizes then follow the rewritten files), fresh otherwise.
   bool progress_header = true, test_header = true;
   if (o.resume) {
     progress_header = adopt_header(dir / "progress.csv", kProgressHeader);
     test_header = adopt_header(dir / "test_returns.csv", kTestHeader);
-    nlohmann::json sizes = state["sizes"];
+    bool changed = false;
     for (const char* name : {"progress.csv", "test_returns.csv"}) {
       std::error_code ec;
       const std::uintmax_t size = fs::exists(dir / name, ec) ? fs::file_size(dir / name, ec) : 0;
-      sizes[name] = size;
+      changed = changed || size != state.sizes[name];
+      state.sizes[name] = size;
     }
-    if (sizes != state["sizes"]) {
-      state["sizes"] = sizes;
-      write_atomically(state_file, state.dump(2) + "\n");
+    if (changed) {
+      nlohmann::json saved = nlohmann::json::parse(std::ifstream(state_file));
+      for (const char* name : {"progress.csv", "test_returns.csv"})
+        saved["sizes"][name] = state.sizes[name];
+      write_atomically(state_file, saved.dump(2) + "\n");
     }
   }
   std::ofstream progress(dir / "progress.csv", progress_header ? std::ios::trunc : std::ios::app);
@@ -401,8 +457,8 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   if (test_header) test_csv << kTestHeader << "\n";
   JsonlWriter teacher_log(dir / "teacher.jsonl", o.resume);
 
-  int evaluation = o.resume ? state["evaluation"].get<int>() + 1 : 0;
-  const double wall_before = o.resume ? state["wall_s"].get<double>() : 0.0;
+  int evaluation = o.resume ? state.evaluation + 1 : 0;
+  const double wall_before = o.resume ? state.wall_s : 0.0;
   const auto start = Clock::now();
   const long first_steps = run_steps();
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
@@ -424,60 +480,13 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
       teacher_log.write({{"kind", "periodical"}, {"env_steps", p.env_steps}, {"tasks", p.tasks}});
   };
 
-  // One evaluation: every test task once, deterministic policy, then the files and a checkpoint.
-  std::vector<double> action(static_cast<std::size_t>(test_env->action_space().size()));
-  auto evaluate = [&] {
-    const auto eval_start = Clock::now();
-    const long steps = run_steps();
-    drain_teacher();
-    std::vector<double> returns;
-    const std::vector<std::string>& names = env.space.dim_names();
-    envs::ResetOptions task_options;
-    for (int i = 0; i < controller->test_set_size(); ++i) {
-      const teach::Task task = controller->next_test_task();
-      for (std::size_t d = 0; d < names.size(); ++d) task_options[names[d]] = task[d];
-      test_env->set_reset_options(task_options);
-      test_env->reset(o.seed * 1000003 + 100000 + static_cast<std::uint64_t>(i));
-      double ret = 0;
-      int length = 0;
-      for (;;) {
-        learner->act(test_env->observation(), action, /*deterministic=*/true);
-        const envs::StepResult r = test_env->step(action);
-        ret += r.reward;
-        ++length;
-        if (r.terminated || r.truncated) break;
-      }
-      controller->record_test_episode(ret, length);
-      returns.push_back(ret);
-      const bool mastered = ret > env.success_threshold;
-      test_csv << evaluation << "," << steps << "," << i << "," << csv_cell(ret) << ","
-               << (mastered ? 1 : 0) << "\n";
-    }
-    double mean = 0, var = 0;
-    int mastered = 0;
-    for (double r : returns) {
-      mean += r / returns.size();
-      mastered += r > env.success_threshold;
-    }
-    for (double r : returns) var += (r - mean) * (r - mean) / returns.size();
-    const double pct = 100.0 * mastered / returns.size();
-    result.eval_s += std::chrono::duration<double>(Clock::now() - eval_start).count();
-    const double wall = wall_before + elapsed();
-    progress << evaluation << "," << steps << "," << controller->episodes() << "," << csv_cell(wall)
-             << "," << csv_cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << ","
-             << csv_cell(mean) << "," << csv_cell(std::sqrt(var)) << "," << csv_cell(pct) << ","
-             << csv_cell(train_returns ? train_return_sum / train_returns : std::nan("")) << ","
-             << csv_cell(updates_done) << "," << csv_cell(train_env->teacher_seconds()) << "\n";
-    train_return_sum = 0;
-    train_returns = 0;
-    teacher_log.write(teach::dump_line(steps, controller->teacher_dump()));
-    // The checkpoint: the learner, then the state naming the logs' sizes at this point.
-    progress.flush();
-    test_csv.flush();
-    teacher_log.flush();
-    if (!progress || !test_csv)
-      throw UserError("cannot write the run's logs in '" + dir.string() + "'");
-    learn::save_run_checkpoint(latest, *learner, nullptr,
+  // The resume point, one atomic step: the checkpoint goes to step_<N>.ckpt (a new file), then
+  // latest.json names N (a rename), then latest.ckpt becomes the same file and the previous step
+  // file goes. A kill at any point leaves a latest.json whose checkpoint exists.
+  long last_step_file = o.resume ? state.env_steps : -1;
+  auto save_resume_point = [&](long steps, double wall) {
+    const fs::path step_file = checkpoints / ("step_" + std::to_string(steps) + ".ckpt");
+    learn::save_run_checkpoint(step_file, *learner, nullptr,
                                {.steps = learner->steps(), .episodes = controller->episodes()});
     nlohmann::json saved{{"env_steps", steps},
                          {"learner_steps", learner->steps()},
@@ -488,59 +497,127 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
                          {"wall_s", wall}};
     for (const char* name : kLogs) saved["sizes"][name] = fs::file_size(dir / name);
     write_atomically(state_file, saved.dump(2) + "\n");
+    const fs::path tmp = latest.string() + ".tmp";
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    fs::create_hard_link(step_file, tmp, ec);
+    if (ec) fs::copy_file(step_file, tmp, fs::copy_options::overwrite_existing, ec);
+    if (!ec) fs::rename(tmp, latest, ec);
+    if (ec) throw UserError("cannot write '" + latest.string() + "': " + ec.message());
+    if (last_step_file >= 0 && last_step_file != steps) {
+      fs::remove(checkpoints / ("step_" + std::to_string(last_step_file) + ".ckpt"), ec);
+    }
+    last_step_file = steps;
+  };
+
+  // One evaluation: every test task once, deterministic policy (the one evaluation rollout),
+  // then the files and the resume point.
+  auto evaluate = [&] {
+    const auto eval_start = Clock::now();
+    const long steps = run_steps();
+    drain_teacher();
+    const std::vector<std::string>& names = env.space.dim_names();
+    std::vector<teach::Task> tasks;
+    std::vector<std::uint64_t> seeds;
+    for (int i = 0; i < controller->test_set_size(); ++i) {
+      tasks.push_back(controller->next_test_task());
+      seeds.push_back(o.seed * 1000003 + 100000 + static_cast<std::uint64_t>(i));
+    }
+    learn::Learner* student = learner.get();
+    const std::vector<EpisodeOutcome> episodes = run_episodes(
+        *test_env,
+        {.act = [student](const envs::ObservationBuffers& obs,
+                          std::span<double> action) { student->act(obs, action, true); }},
+        seeds, 0, nullptr, [&](int i, envs::Env& e) {
+          envs::ResetOptions task_options;
+          for (std::size_t d = 0; d < names.size(); ++d) task_options[names[d]] = tasks[i][d];
+          e.set_reset_options(task_options);
+        });
+    double mean = 0, var = 0;
+    int mastered = 0;
+    for (std::size_t i = 0; i < episodes.size(); ++i) {
+      const double ret = episodes[i].episode_return;
+      controller->record_test_episode(ret, episodes[i].length);
+      test_csv << evaluation << "," << steps << "," << i << "," << csv_cell(ret) << ","
+               << (ret > env.success_threshold ? 1 : 0) << "\n";
+      mean += ret / episodes.size();
+      mastered += ret > env.success_threshold;
+    }
+    for (const EpisodeOutcome& e : episodes)
+      var += (e.episode_return - mean) * (e.episode_return - mean) / episodes.size();
+    const double pct = 100.0 * mastered / episodes.size();
+    result.eval_s += std::chrono::duration<double>(Clock::now() - eval_start).count();
+    const double wall = wall_before + elapsed();
+    progress << evaluation << "," << steps << "," << controller->episodes() << "," << csv_cell(wall)
+             << "," << csv_cell((steps - first_steps) / std::max(elapsed(), 1e-9)) << ","
+             << csv_cell(mean) << "," << csv_cell(std::sqrt(var)) << "," << csv_cell(pct) << ","
+             << csv_cell(train_returns ? train_return_sum / train_returns : std::nan("")) << ","
+             << csv_cell(updates_done) << "," << csv_cell(train_env->teacher_seconds()) << "\n";
+    train_return_sum = 0;
+    train_returns = 0;
+    teacher_log.write(teach::dump_line(steps, controller->teacher_dump()));
+    progress.flush();
+    test_csv.flush();
+    teacher_log.flush();
+    if (!progress || !test_csv)
+      throw UserError("cannot write the run's logs in '" + dir.string() + "'");
+    save_resume_point(steps, wall);
     result.last_pct_mastered = pct;
     result.checkpoint_steps = steps;
     ++result.evaluations;
     ++evaluation;
   };
 
-  // Evaluation 0 before training; then train to each evaluation (and student reset) in turn.
-  if (!o.resume) evaluate();
+  // Evaluation 0 before training; then the shared loop trains exactly to each evaluation and
+  // student reset in turn, and the run evaluates once more at its end.
+  long last_evaluated = o.resume ? state.env_steps : -1;
+  auto evaluate_now = [&] {
+    evaluate();
+    last_evaluated = run_steps();
+  };
+  if (!o.resume) evaluate_now();
   auto next_multiple = [&](long every) { return (run_steps() / every + 1) * every; };
   long next_eval = next_multiple(o.test_every);
   long next_reset = o.reset_frequency > 0 ? next_multiple(o.reset_frequency) : o.total_steps;
   auto stopped = [&] { return o.stop && o.stop->load(); };
-  while (run_steps() < o.total_steps && !stopped()) {
-    const long target = std::min({next_eval, next_reset, o.total_steps});
-    const long before = run_steps();
-    learner->learn(target - offset, [&](const learn::TrainStats& s) {
-      const auto it = s.losses.find("updates");
-      if (it != s.losses.end()) {
-        if (std::isnan(updates_done)) updates_done = 0;
-        if (std::isnan(updates_seen)) updates_seen = o.resume ? it->second : 0;
-        updates_done += it->second - updates_seen;
-        updates_seen = it->second;
-      }
-      drain_teacher();
-      if (o.progress_bar) {
-        const long steps = offset + s.steps;
-        const double done = static_cast<double>(steps) / o.total_steps;
-        const double rate = (steps - first_steps) / std::max(elapsed(), 1e-9);
-        const int width = 30, filled = static_cast<int>(std::min(1.0, done) * width);
-        std::fprintf(stderr, "\r[%s%s] %ld/%ld steps  %.0f steps/s  ETA %s  mastered %s%% ",
-                     std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                     steps, o.total_steps, rate,
-                     duration_text((o.total_steps - steps) / std::max(rate, 1e-9)).c_str(),
-                     csv_cell(result.last_pct_mastered).c_str());
-        std::fflush(stderr);
-      }
-      return !stopped();
-    });
-    if (run_steps() == before) break;  // a learner that cannot advance
-    // A fresh student (networks, optimiser, buffer) every reset_frequency steps.
-    if (o.reset_frequency > 0 && run_steps() >= next_reset && run_steps() < o.total_steps) {
-      offset = run_steps();
-      ++student_resets;
-      learner = make_student();
-      updates_seen = 0;
-      next_reset = next_multiple(o.reset_frequency);
-    }
-    if (run_steps() >= next_eval || run_steps() >= o.total_steps) {
-      evaluate();
-      next_eval = next_multiple(o.test_every);
-    }
-  }
-  if (o.progress_bar) std::fprintf(stderr, "\n");
+  const ProgressBar bar(o.total_steps, first_steps, o.progress_bar);
+  run_loop([&]() -> learn::Learner& { return *learner; },
+           {.total_steps = o.total_steps,
+            .next_boundary = [&](long) { return std::min(next_eval, next_reset); },
+            .offset = [&] { return offset; },
+            .report =
+                [&](const learn::TrainStats& s) {
+                  const auto it = s.losses.find("updates");
+                  if (it != s.losses.end()) {
+                    if (std::isnan(updates_done)) updates_done = 0;
+                    if (std::isnan(updates_seen)) updates_seen = o.resume ? it->second : 0;
+                    updates_done += it->second - updates_seen;
+                    updates_seen = it->second;
+                  }
+                  drain_teacher();
+                  bar.show(offset + s.steps, elapsed(),
+                           "mastered " + csv_cell(result.last_pct_mastered) + "%");
+                  return true;
+                },
+            // A fresh student (networks, optimiser, buffer) every reset_frequency steps, then the
+            // evaluation when one is due.
+            .at_boundary =
+                [&] {
+                  if (o.reset_frequency > 0 && run_steps() >= next_reset) {
+                    offset = run_steps();
+                    ++student_resets;
+                    learner = make_student();
+                    updates_seen = 0;
+                    next_reset = next_multiple(o.reset_frequency);
+                  }
+                  if (run_steps() >= next_eval) {
+                    evaluate_now();
+                    next_eval = next_multiple(o.test_every);
+                  }
+                },
+            .stopping = stopped});
+  if (run_steps() >= o.total_steps && run_steps() != last_evaluated) evaluate_now();
+  bar.finish();
   drain_teacher();
   teacher_log.flush();
 

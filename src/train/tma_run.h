@@ -1,8 +1,10 @@
 // A TeachMyAgent student run (`cradle tma run`, the reference's run.py): one learner (SAC or PPO
 // with the reference presets) trained on envs whose tasks a teacher picks, evaluated every
 // test_every env steps on a test set with the deterministic policy. The env family comes in
-// through factories, so this loop knows only envs::Env. Writes the run folder of docs/tma_run.md:
-// run.json, progress.csv, test_returns.csv, test_set.csv, teacher.jsonl, checkpoints/.
+// through factories, so this run knows only envs::Env; it trains through the shared loop
+// (train/loop.h) and evaluates with the shared rollout (train/episodes.h). Writes the run folder of
+// docs/tma_run.md: run.json, progress.csv, test_returns.csv, test_set.csv, teacher.jsonl,
+// checkpoints/ (step_<N>.ckpt and latest.ckpt of the last evaluation, latest.json naming it).
 #pragma once
 
 #include <atomic>
@@ -50,6 +52,7 @@ struct StudentRunOptions {
   std::map<std::string, std::string> hyperparameters;  // over the preset
   std::filesystem::path out;
   bool resume = false;
+  bool overwrite = false;  // replace a run already in `out` (without it or resume: refused)
   bool progress_bar = true;
   // Written into run.json beside the parsed values (the command line's arguments as given).
   nlohmann::ordered_json arguments = nlohmann::ordered_json::object();

@@ -298,12 +298,8 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                      ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed),
                                        teacher_seed)
                      : make_controller(spec, teacher_seed);
-    if (options.resume && fs::exists(teacher_file)) {
-      for (const nlohmann::json& e : read_jsonl(teacher_file))
-        if (e.value("kind", "") == "train")
-          curriculum->replay_train_episode(e["task"].get<teach::Task>(), e["return"], e["length"],
-                                           e["success"], e["env_steps"]);
-    }
+    if (options.resume && fs::exists(teacher_file))
+      replay_teacher_book(*curriculum, teacher_file, /*periodical=*/false);
     wrap = [curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
       return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
     };

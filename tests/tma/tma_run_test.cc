@@ -191,18 +191,108 @@ TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
   EXPECT_EQ(cells(progress[4])[1], "3000");
   EXPECT_FALSE(cells(progress[4]).back().empty());  // teacher_s
 
-  // A column that would be lost: the old file is kept whole beside a fresh one.
+  // A column that would be lost: the old file is kept whole beside, and its rows go on under the
+  // current header (the unknown column left out), so the evaluations stay numbered 0, 1, 2, 3.
   EXPECT_EQ(read_lines(dir / "test_returns.before-resume.csv"), old_tests);
   const std::vector<std::string> tests = read_lines(dir / "test_returns.csv");
-  ASSERT_EQ(tests.size(), 1u + 4);
+  ASSERT_EQ(tests.size(), 1u + 4 * 4);
   EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
-  EXPECT_EQ(cells(tests[1])[0], "3");
+  for (int k = 1; k <= 12; ++k) {
+    EXPECT_EQ(tests[k], old_tests[k].substr(0, old_tests[k].rfind(',') + 1)) << k;
+  }
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(cells(tests[1 + 4 * k])[0], std::to_string(k));
 
   // The checkpoint now names the rewritten files' sizes: resuming again cuts nothing.
   r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_FALSE(fs::exists(dir / "progress.after-checkpoint.csv"));
   EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
+}
+
+// The resume point is one atomic step: a kill after the next checkpoint was written but before
+// latest.json named it (simulated by putting the earlier latest.json and step file back) still
+// resumes, from the earlier evaluation, to the same files as an uninterrupted run.
+TEST(TmaRun, AKillBetweenCheckpointAndResumePointStillResumes) {
+  const fs::path dir = fresh("cradle_tma_run_atomic");
+  const std::string args = kSac + "--teacher Random --out " + dir.string();
+  ASSERT_EQ(run_cradle(args + " --nb_env_steps 0.002").status, 0);
+  const fs::path ckpts = dir / "checkpoints";
+  EXPECT_TRUE(fs::exists(ckpts / "step_2000.ckpt"));
+  EXPECT_EQ(fs::file_size(ckpts / "step_2000.ckpt"), fs::file_size(ckpts / "latest.ckpt"));
+  const fs::path saved = fresh("cradle_tma_run_atomic_saved");
+  fs::create_directories(saved);
+  fs::copy(ckpts / "latest.json", saved / "latest.json");
+  fs::copy(ckpts / "step_2000.ckpt", saved / "step_2000.ckpt");
+
+  ASSERT_EQ(run_cradle(args + " --nb_env_steps 0.003 --resume").status, 0);
+  const std::vector<std::string> uninterrupted = read_lines(dir / "test_returns.csv");
+  EXPECT_FALSE(fs::exists(ckpts / "step_2000.ckpt"));  // only the last step file is kept
+  EXPECT_TRUE(fs::exists(ckpts / "step_3000.ckpt"));
+
+  // latest.ckpt is of 3000 steps, latest.json of 2000: the step file it names is used.
+  fs::copy(saved / "latest.json", ckpts / "latest.json", fs::copy_options::overwrite_existing);
+  fs::copy(saved / "step_2000.ckpt", ckpts / "step_2000.ckpt");
+  const RunResult r = run_cradle(args + " --nb_env_steps 0.003 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(read_lines(dir / "test_returns.csv"), uninterrupted);
+  EXPECT_EQ(cells(read_lines(dir / "progress.csv").back())[0], "3");
+}
+
+// A finished run is never replaced silently; --overwrite replaces it; a damaged resume point or
+// teacher book is a one-line error naming the file, and nothing in the folder changes.
+TEST(TmaRun, FinishedRunsAndDamagedFilesAreRefused) {
+  const fs::path dir = fresh("cradle_tma_run_refuse");
+  const std::string run_args = kSac + "--teacher Random --out " + dir.string();
+  const std::string args = run_args + " --nb_env_steps 0.001";
+  ASSERT_EQ(run_cradle(args).status, 0);
+  const std::vector<std::string> progress = read_lines(dir / "progress.csv");
+  RunResult r = run_cradle(args);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("holds a run; give --resume to continue it, --overwrite"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
+
+  auto one_line_naming = [](const RunResult& res, const std::string& what) {
+    EXPECT_EQ(res.status, 1) << res.out;
+    EXPECT_EQ(std::count(res.out.begin(), res.out.end(), '\n'), 1) << res.out;
+    EXPECT_NE(res.out.find(what), std::string::npos) << res.out;
+  };
+  const fs::path state = dir / "checkpoints" / "latest.json";
+  const std::vector<std::string> good_state = read_lines(state);
+  const std::string resume = run_args + " --nb_env_steps 0.002 --resume";
+  for (const char* bad : {"[]", "{\"env_steps\": \"x\"}", "{", "\x01\x02garbage"}) {
+    std::ofstream(state, std::ios::trunc) << bad;
+    one_line_naming(run_cradle(resume), "latest.json");
+    EXPECT_EQ(read_lines(dir / "progress.csv"), progress) << bad;
+  }
+  {
+    std::ofstream out(state, std::ios::trunc);
+    for (const std::string& l : good_state) out << l << "\n";
+  }
+  const std::vector<std::string> book = read_lines(dir / "teacher.jsonl");
+  for (const char* bad :
+       {"{\"env_steps\": 3}", "{\"kind\": \"train\", \"task\": [1]}", "{\"kind\": \"nonsense\"}"}) {
+    {
+      std::ofstream out(dir / "teacher.jsonl", std::ios::trunc);
+      out << bad << "\n";
+      for (const std::string& l : book) out << l << "\n";
+    }
+    one_line_naming(run_cradle(resume), "teacher.jsonl:1: ");
+    EXPECT_EQ(read_lines(dir / "progress.csv"), progress) << bad;
+  }
+  {
+    std::ofstream out(dir / "teacher.jsonl", std::ios::trunc);
+    for (const std::string& l : book) out << l << "\n";
+  }
+  // An output path that cannot be a folder.
+  one_line_naming(run_cradle(kSac + "--nb_env_steps 0.001 --out /proc/cradle_x"),
+                  "cannot create the run folder '/proc/cradle_x'");
+  one_line_naming(run_cradle(kSac + "--nb_env_steps 0.001 --out " + (dir / "run.json").string()),
+                  "is a file; expected a run folder");
+
+  r = run_cradle(args + " --overwrite");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(read_lines(dir / "progress.csv").size(), progress.size());
 }
 
 TEST(TmaRun, PpoStudentWithStudentReset) {

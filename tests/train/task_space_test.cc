@@ -270,5 +270,55 @@ TEST(TaskSpaceFile, CubesFileMovesTheStackAwayFromMimo) {
   EXPECT_THROW(crib.set_reset_options({{"cube_distance", 0.3}}), UserError);
 }
 
+// A resumed run's teacher book: every line checked before the teacher hears any; a damaged line
+// is one line naming the file, the line and the key.
+TEST(TeacherBook, ReplaysGoodBooksAndRefusesDamagedLinesWhole) {
+  const CurriculumSpec spec =
+      parse_task_space("teacher: Random\nparams:\n  a: [0, 1]\n  b: [0, 2]\n", "book.yml");
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "cradle_teacher_book.jsonl";
+  const std::string good =
+      R"({"kind":"train","episode":0,"env_steps":10,"task":[0.5,1],"return":3,"length":10,)"
+      R"("success":false})"
+      "\n"
+      R"({"kind":"dump","env_steps":10,"teacher":{}})"
+      "\n"
+      R"({"kind":"periodical","env_steps":10,"tasks":[[0.1,0.2]]})"
+      "\n";
+  std::ofstream(file, std::ios::trunc) << good;
+  auto controller = make_controller(spec, 1);
+  replay_teacher_book(*controller, file, /*periodical=*/true);
+  EXPECT_EQ(controller->episodes(), 1);
+  EXPECT_EQ(controller->env_steps(), 10);
+
+  const std::pair<const char*, const char*> damaged[] = {
+      {R"({"env_steps":3})", R"(:1: the line has no key "kind")"},
+      {R"({"kind":"train","env_steps":3,"task":[1],"return":0,"length":1,"success":true})",
+       R"(:1: the line: "task" has 1 numbers; expected a task of 2 numbers)"},
+      {R"({"kind":"train","env_steps":-3,"task":[1,1],"return":0,"length":1,"success":true})",
+       R"(:1: the line: "env_steps" is -3; expected an integer >= 0)"},
+      {R"({"kind":"train","env_steps":3,"task":[1,1],"return":"x","length":1,"success":true})",
+       R"(:1: the line: "return" is "x"; expected a number)"},
+      {R"({"kind":"periodical","env_steps":3,"tasks":[[1]]})", "a periodical task is not"},
+      {R"({"kind":"sorcery"})", R"("kind" is "sorcery"; expected train, periodical or dump)"},
+      {R"([1,2])", ":1: the line is not a JSON object"}};
+  for (const auto& [line, message] : damaged) {
+    std::ofstream(file, std::ios::trunc) << line << "\n" << good;
+    auto fresh = make_controller(spec, 1);
+    try {
+      replay_teacher_book(*fresh, file, true);
+      ADD_FAILURE() << "accepted: " << line;
+    } catch (const UserError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      EXPECT_NE(what.find(file.string() + ":1: "), std::string::npos) << what;
+      EXPECT_NE(what.find(message), std::string::npos) << what;
+    }
+    EXPECT_EQ(fresh->episodes(), 0) << line;  // nothing heard
+    EXPECT_THROW(check_teacher_book(file, 2), UserError) << line;
+  }
+  std::filesystem::remove(file);
+}
+
 }  // namespace
 }  // namespace cradle::train

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "train/sami/sami_json.h"
+#include "train/run_json.h"
 #include "train/sami/sami_train.h"
 
 namespace cradle::train {
@@ -107,7 +107,7 @@ std::string sami_table(const std::vector<std::filesystem::path>& runs,
       const std::filesystem::path file = run / ("eval_" + split + ".json");
       std::error_code ec;
       if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) continue;
-      const SamiJson j(file, "the eval_" + split + ".json of `cradle sami evaluate`");
+      const RunJson j(file, "the eval_" + split + ".json of `cradle sami evaluate`");
       const std::string env = j.string("env");
       const double score = env == "PandaPush" ? j.number("success_rate") : j.number("mean_return");
       scores[env][j.string("method")][split].push_back(score);

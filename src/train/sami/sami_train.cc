@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/sealed_file.h"
 #include "eval/video.h"
 #include "learn/checkpoint.h"
 #include "learn/meta/context_sac.h"
@@ -21,7 +22,8 @@
 #include "sami/render.h"
 #include "sami/task.h"
 #include "sami/vector.h"
-#include "train/sami/sami_json.h"
+#include "train/loop.h"
+#include "train/run_json.h"
 
 namespace cradle::train {
 namespace {
@@ -54,20 +56,7 @@ SamiConfig make_config(sami::EnvId id, const std::map<std::string, std::string>&
   return config;
 }
 
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file);
-  out << text;
-  if (!out) throw UserError("sami: cannot write " + file.string());
-}
-
 std::vector<float> to_vector(std::span<const float> x) { return {x.begin(), x.end()}; }
-
-std::string number(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.6g", v);
-  return buf;
-}
 
 std::string cell_name(const sami::TaskSet& set, bool panda) {
   std::ostringstream s;
@@ -77,7 +66,7 @@ std::string cell_name(const sami::TaskSet& set, bool panda) {
   }
   const auto list = [&](const std::vector<double>& v) {
     std::string out;
-    for (double x : v) out += (out.empty() ? "" : " ") + number(x);
+    for (double x : v) out += (out.empty() ? "" : " ") + csv_cell(x);
     return out;
   };
   s << "mass {" << list(set.mass) << "} damping {" << list(set.damping) << "}";
@@ -95,7 +84,7 @@ std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id) {
 }
 
 SamiRunFile read_sami_run(const std::filesystem::path& run) {
-  const SamiJson j(run / "run.json", "the run.json of a `cradle sami train` run");
+  const RunJson j(run / "run.json", "the run.json of a `cradle sami train` run");
   SamiRunFile r{.env = j.string("env"),
                 .method = j.string("method"),
                 .seed = j.unsigned_integer("seed"),
@@ -106,7 +95,7 @@ SamiRunFile read_sami_run(const std::filesystem::path& run) {
     sami::env_from_name(r.env);
     learn::meta::method_contrast(r.method);
   } catch (const UserError& e) {
-    throw UserError(j.file().string() + ": " + e.what());
+    throw UserError(j.where() + ": " + e.what());
   }
   return r;
 }
@@ -190,7 +179,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
                          {"hyperparameters", hp},
                          {"config", config_text},
                          {"training_sets", sets.size()}};
-    write_text(run / "run.json", saved.dump(2) + "\n");
+    write_atomically(run / "run.json", saved.dump(2) + "\n");
   }
   std::ofstream csv(progress, append ? std::ios::app : std::ios::trunc);
   if (!append) csv << kProgressHeader << "\n";
@@ -226,6 +215,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   SamiTrainResult result{.run = run};
   const Clock::time_point start = Clock::now();
   Clock::time_point report_start = start;
+  const ProgressBar bar(total, steps, options.progress_bar);
   long report_steps_from = steps, report_updates = 0;
   double update_seconds = 0, report_update_seconds = 0;
   long updates = 0, vector_step = 0, last_checkpoint = steps;
@@ -298,8 +288,8 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
         add("sance_weight", l.weight);
         if (!std::isfinite(l.critic) || !std::isfinite(l.actor)) {
           throw UserError("sami train: the update diverged at step " + std::to_string(steps) +
-                          " (critic loss " + number(l.critic) + "); the last good checkpoint is " +
-                          checkpoint.string());
+                          " (critic loss " + csv_cell(l.critic) +
+                          "); the last good checkpoint is " + checkpoint.string());
         }
       }
       const double dt = seconds(t0, Clock::now());
@@ -318,19 +308,13 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
       const double gps = report_update_seconds > 0 ? report_updates / report_update_seconds : 0;
       const double ret = report_episodes ? report_return / report_episodes : std::nan("");
       const double success = report_episodes ? report_success / report_episodes : std::nan("");
-      csv << steps << "," << report_episodes << "," << number(ret) << "," << number(success) << ","
-          << number(mean("critic_loss")) << "," << number(mean("actor_loss")) << ","
-          << number(mean("alpha")) << "," << number(mean("entropy")) << ","
-          << number(mean("sance_loss")) << "," << number(mean("sance_weight")) << "," << number(sps)
-          << "," << number(gps) << "," << learner.updates() << "\n";
+      csv << steps << "," << report_episodes << "," << csv_cell(ret) << "," << csv_cell(success)
+          << "," << csv_cell(mean("critic_loss")) << "," << csv_cell(mean("actor_loss")) << ","
+          << csv_cell(mean("alpha")) << "," << csv_cell(mean("entropy")) << ","
+          << csv_cell(mean("sance_loss")) << "," << csv_cell(mean("sance_weight")) << ","
+          << csv_cell(sps) << "," << csv_cell(gps) << "," << learner.updates() << "\n";
       csv.flush();
-      if (options.progress_bar) {
-        const int width = 30;
-        const int filled = static_cast<int>(width * std::min(1.0, double(steps) / total));
-        std::fprintf(stderr, "\r[%s%s] %ld/%ld steps  %.0f steps/s  %.1f grad/s  return %s ",
-                     std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
-                     steps, total, sps, gps, number(ret).c_str());
-      }
+      bar.show(steps, seconds(start, now), csv_cell(gps) + " grad/s  return " + csv_cell(ret));
       if (report_episodes) result.last_return = ret;
       report_return = report_success = 0;
       report_episodes = 0;
@@ -349,7 +333,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
       break;
     }
   }
-  if (options.progress_bar) std::fprintf(stderr, "\n");
+  bar.finish();
   result.steps = steps;
   result.updates = learner.updates();
   result.sps = steps / std::max(seconds(start, Clock::now()), 1e-9);
@@ -409,7 +393,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
       // crippled joints ("0+4"; "none").
       const sami::Info& drawn = env->info();
       const std::string episode_task =
-          number(drawn.mass) + "," + number(drawn.damping) + "," +
+          csv_cell(drawn.mass) + "," + csv_cell(drawn.damping) + "," +
           (drawn.crippled.empty() ? "none" : sami::joints_text(drawn.crippled, "+"));
       ContextSac::Streams streams = learner.streams(1);
       double ret = 0;
@@ -485,9 +469,9 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   for (long r = 0; r < rows; ++r) {
     contexts << context_rows[r];
     for (int k = 0; k < config.context_size; ++k) {
-      contexts << "," << number(context_values[r * config.context_size + k]);
+      contexts << "," << csv_cell(context_values[r * config.context_size + k]);
     }
-    contexts << "," << number(pc[r][0].item<double>()) << "," << number(pc[r][1].item<double>())
+    contexts << "," << csv_cell(pc[r][0].item<double>()) << "," << csv_cell(pc[r][1].item<double>())
              << "\n";
   }
 
@@ -503,9 +487,9 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
                       {"mean_return", result.mean_return},
                       {"cells", nlohmann::json::array()}};
   for (const SamiCell& c : result.cells) {
-    table << "\"" << c.name << "\"," << c.episodes << "," << number(c.success_rate) << ","
-          << number(c.mean_return) << "," << number(c.std_return) << "," << number(c.push) << ","
-          << number(c.roll) << "," << number(c.pick_and_place) << "\n";
+    table << "\"" << c.name << "\"," << c.episodes << "," << csv_cell(c.success_rate) << ","
+          << csv_cell(c.mean_return) << "," << csv_cell(c.std_return) << "," << csv_cell(c.push)
+          << "," << csv_cell(c.roll) << "," << csv_cell(c.pick_and_place) << "\n";
     json["cells"].push_back({{"cell", c.name},
                              {"episodes", c.episodes},
                              {"success_rate", c.success_rate},
@@ -515,8 +499,8 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
                              {"roll", c.roll},
                              {"pick_and_place", c.pick_and_place}});
   }
-  write_text(result.csv, table.str());
-  write_text(result.json, json.dump(2) + "\n");
+  write_atomically(result.csv, table.str());
+  write_atomically(result.json, json.dump(2) + "\n");
   return result;
 }
 
