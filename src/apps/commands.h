@@ -15,6 +15,7 @@ void register_train(CLI::App& app);
 void register_illustrate(CLI::App& app);
 void register_tma(CLI::App& app);
 void register_tma_campaign(CLI::App& tma);  // under `tma`: campaign, analyze
+void register_campaign(CLI::App& app);      // campaigns of every kind of run
 void register_sami(CLI::App& app);
 void register_launch(CLI::App& app);
 void register_soak(CLI::App& app);

@@ -99,6 +99,8 @@ int main(int argc, char** argv) {
   cradle::apps::register_sami(app);
   group("tma", "Families (reference-compatible commands)");
   group("sami", "Families (reference-compatible commands)");
+  cradle::apps::register_campaign(app);
+  group("campaign", "Train");
   cradle::apps::register_bench(app);
   cradle::apps::register_soak(app);
   group("bench", "Benchmarks");
