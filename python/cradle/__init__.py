@@ -22,6 +22,7 @@ from .env import (
     make_env,
     register_gymnasium_envs,
 )
+from .policy import Policy
 from .registry import RegistryEnv, env_ids, env_spec, env_specs, gymnasium_id
 from .spaces import HAS_GYMNASIUM
 from .training import evaluate, load_policy, load_training_log, train, training_score
@@ -46,6 +47,7 @@ __all__ = [
     "ActionWrapper",
     "BabyBenchEnv",
     "ObservationWrapper",
+    "Policy",
     "RegistryEnv",
     "RewardWrapper",
     "VectorEnv",

@@ -1,9 +1,10 @@
 """Stable-Baselines3 adapter: cradle.sb3.SB3VecEnv is an SB3 VecEnv over Cradle's C++ vector env,
-so SB3 algorithms collect rollouts from N BabyBench envs stepped by C++ threads::
+so SB3 algorithms collect rollouts from N envs of any family stepped by C++ threads::
 
     from stable_baselines3 import PPO
     from cradle.sb3 import SB3VecEnv
-    venv = SB3VecEnv("configs/config_selftouch.yml", num_envs=4)
+    venv = SB3VecEnv("configs/config_selftouch.yml", num_envs=4)      # a BabyBench config
+    venv = SB3VecEnv("tma/parkour:fish", num_envs=4)                  # or any env id
     PPO("MultiInputPolicy", venv).learn(100_000)
 
 SB3 resets an env in the step that ends its episode and reports the last observation as
@@ -14,21 +15,58 @@ Importing this module without stable_baselines3 installed raises ImportError.
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnv as _SB3VecEnv
 
-from .vector import VectorEnv
+from .vector import VectorEnv, _registry_spec
 
 # Keys of the vector infos that are not per-env info values.
 _SKIP = ("final_obs", "final_info")
 
 
 class SB3VecEnv(_SB3VecEnv):
-    """num_envs BabyBench envs as an SB3 VecEnv (training mode by default, as make_env)."""
+    """num_envs envs of a BabyBench config or of any env id as an SB3 VecEnv, or an existing
+    cradle.VectorEnv made with autoreset_mode="same_step".
 
-    def __init__(self, config, num_envs=1, threads=0, training=True, seed=0):
-        self._vec = VectorEnv(config, num_envs, threads=threads, training=training, seed=seed,
-                              autoreset_mode="same_step")
+    Args:
+      env: a BabyBench config (dict, YAML path or parsed config), any listed env id
+        ("tma/parkour:fish", "mimo/reach", "sami/CrippleAnt:moderate"), or a cradle.VectorEnv
+        (then num_envs, threads, training and env_options come from it and must be left out).
+      training: log every episode in the config's training log (BabyBench only; default: True
+        for a BabyBench config or id, as make_env, False otherwise).
+      seed: the seed of the first reset() when SB3 gives none (default 0; an existing vector's
+        own generator when left out).
+      env_options: an env id's constructor options, as cradle.VectorEnv's.
+    """
+
+    def __init__(self, env, num_envs=None, threads=None, training=None, seed=None,
+                 env_options=None):
+        if isinstance(env, VectorEnv):
+            given = [name for name, value in (("num_envs", num_envs), ("threads", threads),
+                                              ("training", training),
+                                              ("env_options", env_options)) if value is not None]
+            if given:
+                raise ValueError(f"{', '.join(given)}: the vector is given, so these come from it "
+                                 "(leave them out)")
+            if env.closed:
+                raise ValueError("the vector is closed; give an open cradle.VectorEnv")
+            if getattr(env, "autoreset_mode", None) != "same_step":
+                raise ValueError("SB3 resets an env in the step that ends its episode: make the "
+                                 "vector with cradle.VectorEnv(..., autoreset_mode=\"same_step\")")
+            self._vec = env
+            self._next_seed = seed
+        else:
+            if isinstance(env, str):
+                spec = _registry_spec(env)  # ValueError naming the closest ids for an unknown id
+                babybench = spec is None or spec.family == "babybench"
+            else:
+                babybench = True
+            if training is None:
+                training = babybench
+            self._vec = VectorEnv(env, 1 if num_envs is None else num_envs,
+                                  threads=0 if threads is None else threads, training=training,
+                                  seed=0 if seed is None else seed, autoreset_mode="same_step",
+                                  env_options=env_options)
+            self._next_seed = 0 if seed is None else seed
         self._actions = None
-        self._next_seed = seed
-        super().__init__(num_envs, self._vec.single_observation_space,
+        super().__init__(self._vec.num_envs, self._vec.single_observation_space,
                          self._vec.single_action_space)
 
     def _infos(self, infos, dones, truncated, terminated):

@@ -7,6 +7,7 @@ import pickle
 
 from . import _cradle
 from .env import load_config
+from .policy import load_run_policy
 
 # Per behaviour, the keys of a reference training.pkl entry, in the reference's order.
 _REFERENCE_KEYS = {
@@ -144,17 +145,43 @@ def train(
     return result
 
 
-def load_policy(config, checkpoint, stochastic=False):
-    """A trained checkpoint's policy, for evaluate(policy=...): its mean action, or with
-    stochastic=True actions sampled from its distribution by the checkpoint's own generator."""
-    return _cradle.load_policy(load_config(config), os.fspath(checkpoint), bool(stochastic))
+def load_policy(run_folder, checkpoint="final", deterministic=True, *, stochastic=None):
+    """A trained policy.
+
+    load_policy(run_folder, checkpoint="final", deterministic=True): the policy of a run folder
+    of any family (cradle.train(env=...) or `cradle train`, which write run.json and
+    checkpoints/), a cradle.Policy with predict(obs) -> action and reset(); checkpoint is "final",
+    "latest", "step_<n>" or a .ckpt path; deterministic=False samples the actions from the
+    policy's distribution by the checkpoint's own generator.
+
+    load_policy(config, checkpoint, stochastic=False): a BabyBench config and a checkpoint path,
+    for evaluate(config, policy=...): its mean action, or with stochastic=True actions sampled
+    from its distribution.
+    """
+    folder = isinstance(run_folder, (str, os.PathLike)) and os.path.isdir(run_folder)
+    if folder:
+        if stochastic is not None:
+            raise ValueError("stochastic is for a BabyBench config's checkpoint; a run folder's "
+                             "policy takes deterministic=False instead")
+        return load_run_policy(run_folder, checkpoint, deterministic)
+    if isinstance(run_folder, (str, os.PathLike)) and not os.path.exists(run_folder):
+        raise FileNotFoundError(f"'{os.fspath(run_folder)}' does not exist; expected a run folder "
+                                "(it holds run.json) or a BabyBench config")
+    if checkpoint == "final":
+        raise ValueError("a BabyBench config needs the checkpoint file: load_policy(config, "
+                         "'results/.../checkpoints/final.ckpt'), or give the run folder instead")
+    if not isinstance(checkpoint, (str, os.PathLike)):
+        raise ValueError(f"checkpoint must be a .ckpt path, not {checkpoint!r}")
+    sampled = (not deterministic) if stochastic is None else bool(stochastic)
+    return _cradle.load_policy(load_config(run_folder), os.fspath(checkpoint), sampled)
 
 
-def evaluate(config, episodes=10, duration=1000, render=True, seed=0, policy=None,
+def evaluate(config, episodes=10, duration=1000, render=False, seed=0, policy=None,
              video_format="mp4", quiet=False, stochastic=False):
     """Runs the evaluation as `cradle evaluate`: prints the training-log score, runs `episodes`
-    episodes of `duration` steps, writes trajectories/, videos/, evaluation.json and plots/ under
-    save_dir, and returns the report as a dict.
+    episodes of `duration` steps, writes trajectories/, evaluation.json and plots/ under save_dir,
+    and returns the report as a dict. render=True also films every episode into videos/ (as
+    `cradle evaluate --render`; a filmed frame costs 0.15-0.35 s, so it is off by default).
 
     policy: None (uniform random actions), a checkpoint path, a load_policy() result, or a
     callable fn(obs) -> action (fresh observation arrays; called with the GIL for each step).
@@ -166,6 +193,8 @@ def evaluate(config, episodes=10, duration=1000, render=True, seed=0, policy=Non
                          "(use load_policy(config, path, stochastic=True) otherwise)")
     if video_format not in ("mp4", "avi"):
         raise ValueError("video_format must be 'mp4' or 'avi'")
+    if not isinstance(render, (bool, int)) or render not in (True, False):
+        raise ValueError(f"render must be True or False, not {render!r}")
     if isinstance(policy, os.PathLike):
         policy = os.fspath(policy)
     report = _cradle.evaluate(load_config(config), int(episodes), int(duration), bool(render),

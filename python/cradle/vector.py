@@ -98,6 +98,7 @@ class VectorEnv(_VectorBase):
             self._core = _cradle.VecEnv(self._config, int(num_envs), int(threads), bool(training),
                                         int(seed), autoreset_mode == "same_step", int(procs))
         self.num_envs = int(num_envs)
+        self.autoreset_mode = autoreset_mode  # "next_step" or "same_step", as given
         self.single_observation_space = spaces.from_core_dict(self._core.observation_space)
         self.single_action_space = spaces.from_core_box(self._core.action_space)
         self.observation_space = spaces.batch_space(self.single_observation_space, self.num_envs)

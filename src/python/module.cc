@@ -166,4 +166,5 @@ PYBIND11_MODULE(_cradle, m) {
   cradle::python::bind_sami(m);
   cradle::python::bind_teach(m);
   cradle::python::bind_registry(m);
+  cradle::python::bind_run_policy(m);
 }

@@ -170,7 +170,14 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
   std::vector<std::vector<std::set<int>>> episode_lists;  // per episode, per geom-list key
 
   std::error_code ec;
-  for (const char* sub : {"trajectories", "videos", "plots"}) fs::create_directories(dir / sub, ec);
+  for (const char* sub : {"trajectories", "plots"}) fs::create_directories(dir / sub, ec);
+  // videos/ only holds films: made when filming, and an empty one an earlier evaluation left
+  // (remove() takes only an empty folder) goes, so no evaluation leaves an empty videos/.
+  if (options.render) {
+    fs::create_directories(dir / "videos", ec);
+  } else {
+    fs::remove(dir / "videos", ec);
+  }
   std::unique_ptr<FrameComposer> composer;
   std::vector<std::uint8_t> frame;
   if (options.render) {

@@ -1,91 +1,11 @@
-"""The Gymnasium and SB3 branches of the package, exercised against minimal stand-in modules
-(neither is a Debian package): the env, spaces, wrappers, vector env, registration and the SB3
-VecEnv adapter are built from what those modules provide."""
+"""The Gymnasium and SB3 branches of the package, exercised against the minimal stand-in modules
+of conftest.py (neither is a Debian package): the env, spaces, wrappers, vector env, registration
+and the SB3 VecEnv adapter are built from what those modules provide."""
 
-import os
-import subprocess
-import sys
-import textwrap
+import numpy as np
+import pytest
 
 import cradle
-
-STUB = '''
-import numpy as np
-
-registry = {}
-
-
-def register(id, entry_point, kwargs=None):
-    registry[id] = (entry_point, kwargs)
-
-
-class Env:
-    spec = None
-    _np_random = None
-
-    @property
-    def np_random(self):
-        if self._np_random is None:
-            self._np_random = np.random.default_rng()
-        return self._np_random
-
-    def reset(self, *, seed=None, options=None):
-        if seed is not None:
-            self._np_random = np.random.default_rng(seed)
-
-    @property
-    def unwrapped(self):
-        return self
-
-
-class Wrapper(Env):
-    def __init__(self, env):
-        assert isinstance(env, Env)
-        self.env = env
-
-    def step(self, action):
-        return self.env.step(action)
-
-    def reset(self, **kwargs):
-        return self.env.reset(**kwargs)
-
-
-class ObservationWrapper(Wrapper):
-    pass
-
-
-class RewardWrapper(Wrapper):
-    pass
-
-
-class ActionWrapper(Wrapper):
-    pass
-'''
-
-SPACES = '''
-import numpy as np
-
-
-class Box:
-    def __init__(self, low, high, shape=None, dtype=np.float32):
-        self.low = np.broadcast_to(np.asarray(low, dtype=dtype), shape)
-        self.high = np.broadcast_to(np.asarray(high, dtype=dtype), shape)
-        self.shape = tuple(shape)
-        self.dtype = np.dtype(dtype)
-
-
-class Dict:
-    def __init__(self, spaces):
-        self.spaces = dict(spaces)
-
-    def __getitem__(self, key):
-        return self.spaces[key]
-'''
-
-VECTOR = '''
-class VectorEnv:
-    pass
-'''
 
 SCRIPT = '''
 import gymnasium, numpy as np, cradle
@@ -120,76 +40,83 @@ print("ok")
 '''
 
 
-def test_gymnasium_branch(tmp_path):
-    package = tmp_path / "gymnasium"
-    (package / "vector").mkdir(parents=True)
-    (package / "__init__.py").write_text(STUB + "\nfrom . import spaces, vector\n")
-    (package / "spaces.py").write_text(SPACES)
-    (package / "vector" / "__init__.py").write_text(VECTOR)
-    env = dict(os.environ)
-    package_root = os.path.dirname(os.path.dirname(os.path.abspath(cradle.__file__)))
-    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), package_root])
-    result = subprocess.run([sys.executable, "-c", textwrap.dedent(SCRIPT)], env=env,
-                            capture_output=True, text=True, cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "ok"
+def test_gymnasium_branch(with_gymnasium):
+    assert with_gymnasium(SCRIPT).strip() == "ok"
 
 
-# Stable-Baselines3 2.x's VecEnv constructor, as far as the adapter relies on it.
-SB3_VEC_ENV = '''
-class VecEnv:
-    def __init__(self, num_envs, observation_space, action_space):
-        self.num_envs = num_envs
-        self.observation_space = observation_space
-        self.action_space = action_space
-        self.reset_infos = [{} for _ in range(num_envs)]
-        self._seeds = [None for _ in range(num_envs)]
-        render_modes = self.get_attr("render_modes")
-        self.metadata = {"render_modes": render_modes[0]}
-
-    def seed(self, seed=None):
-        self._seeds = [seed + i for i in range(self.num_envs)]
-
-    def _reset_seeds(self):
-        self._seeds = [None for _ in range(self.num_envs)]
-
-    def step(self, actions):
-        self.step_async(actions)
-        return self.step_wait()
-'''
-
-SB3_SCRIPT = '''
-import numpy as np, cradle
-from cradle.sb3 import SB3VecEnv
-config = cradle.config_dict(cradle.env.CONFIG_DIR + "/config_selftouch.yml")
-config.update(save_dir="run", max_episode_steps=2)
-venv = SB3VecEnv(config, num_envs=2, training=True)
-venv.seed(5)
-obs = venv.reset()
-assert obs["touch"].shape[0] == 2 and venv._seeds == [None, None]
-obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
-assert not dones.any() and rewards.dtype == np.float32 and infos[0]["steps"] == 0
-obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
-assert dones.all()
-assert infos[0]["terminal_observation"]["observation"].shape == (264,)
-assert infos[0]["TimeLimit.truncated"] and infos[1]["steps"] == 1
-obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
-assert not dones.any() and infos[0]["steps"] == 0  # stepped, not reset: the reset was same-step
-venv.close()
-print("ok")
-'''
+def test_sb3_adapter(sb3, tmp_path):
+    config = cradle.config_dict(cradle.env.CONFIG_DIR + "/config_selftouch.yml")
+    config.update(save_dir=str(tmp_path / "run"), max_episode_steps=2)
+    venv = sb3.SB3VecEnv(config, num_envs=2, training=True)
+    venv.seed(5)
+    obs = venv.reset()
+    assert obs["touch"].shape[0] == 2 and venv._seeds == [None, None]
+    obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
+    assert not dones.any() and rewards.dtype == np.float32 and infos[0]["steps"] == 0
+    obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
+    assert dones.all()
+    assert infos[0]["terminal_observation"]["observation"].shape == (264,)
+    assert infos[0]["TimeLimit.truncated"] and infos[1]["steps"] == 1
+    obs, rewards, dones, infos = venv.step(np.zeros((2, 30)))
+    assert not dones.any() and infos[0]["steps"] == 0  # stepped, not reset: the reset was same-step
+    venv.close()
 
 
-def test_sb3_adapter(tmp_path):
-    vec_env = tmp_path / "stable_baselines3" / "common" / "vec_env"
-    vec_env.mkdir(parents=True)
-    (tmp_path / "stable_baselines3" / "__init__.py").write_text("")
-    (tmp_path / "stable_baselines3" / "common" / "__init__.py").write_text("")
-    (vec_env / "__init__.py").write_text(SB3_VEC_ENV)
-    env = dict(os.environ)
-    package_root = os.path.dirname(os.path.dirname(os.path.abspath(cradle.__file__)))
-    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), package_root])
-    result = subprocess.run([sys.executable, "-c", textwrap.dedent(SB3_SCRIPT)], env=env,
-                            capture_output=True, text=True, cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "ok"
+def test_sb3_over_any_env_id(sb3):
+    """An env id's vector as an SB3 VecEnv: the same batches as cradle.VectorEnv in same-step mode,
+    with SB3's terminal_observation and TimeLimit.truncated for the envs whose episode ended."""
+    venv = sb3.SB3VecEnv("tma/stump-tracks:old_classic_bipedal", num_envs=2, seed=3)
+    reference = cradle.VectorEnv("tma/stump-tracks:old_classic_bipedal", 2, seed=3,
+                                 autoreset_mode="same_step")
+    obs = venv.reset()
+    expected, _ = reference.reset(seed=3)
+    assert all(np.array_equal(obs[k], expected[k]) for k in expected)
+    rng = np.random.default_rng(0)
+    ended = 0
+    for _ in range(400):
+        actions = rng.uniform(-1, 1, (2, 4))
+        obs, rewards, dones, infos = venv.step(actions)
+        expected, r, terminated, truncated, expected_infos = reference.step(actions)
+        assert all(np.array_equal(obs[k], expected[k]) for k in expected)
+        assert np.array_equal(rewards, r.astype(np.float32))
+        assert np.array_equal(dones, terminated | truncated)
+        for i in np.flatnonzero(dones):
+            ended += 1
+            final = expected_infos["final_obs"][i]
+            assert all(np.array_equal(infos[i]["terminal_observation"][k], final[k])
+                       for k in final)
+            assert infos[i]["TimeLimit.truncated"] == bool(truncated[i] and not terminated[i])
+    assert ended > 0  # random actions topple the walker well within 400 steps
+    venv.close()
+    reference.close()
+
+
+def test_sb3_truncation_and_an_existing_vector(sb3):
+    vec = cradle.VectorEnv("sami/HalfCheetah", 2, seed=1, autoreset_mode="same_step")
+    venv = sb3.SB3VecEnv(vec)
+    assert venv.num_envs == 2 and venv.observation_space is vec.single_observation_space
+    venv.reset()
+    for step in range(1, 1001):
+        obs, rewards, dones, infos = venv.step(np.zeros((2, 6)))
+        if dones.any():
+            break
+    assert step == 1000 and dones.all()  # HalfCheetah never ends but at its time limit
+    assert all(info["TimeLimit.truncated"] for info in infos)
+    assert infos[0]["terminal_observation"]["observation"].shape == obs["observation"][0].shape
+    venv.close()
+    assert vec.closed
+
+
+def test_sb3_refuses_what_it_cannot_use(sb3):
+    with pytest.raises(ValueError, match="autoreset_mode=\"same_step\""):
+        sb3.SB3VecEnv(cradle.VectorEnv("sami/HalfCheetah", 1))
+    vec = cradle.VectorEnv("sami/HalfCheetah", 1, autoreset_mode="same_step")
+    with pytest.raises(ValueError, match="num_envs: the vector is given"):
+        sb3.SB3VecEnv(vec, num_envs=4)
+    vec.close()
+    with pytest.raises(ValueError, match="closed"):
+        sb3.SB3VecEnv(vec)
+    with pytest.raises(ValueError, match="closest"):
+        sb3.SB3VecEnv("tma/stump-trax", num_envs=2)
+    with pytest.raises(ValueError, match="training=True is for BabyBench"):
+        sb3.SB3VecEnv("mimo/reach", training=True)

@@ -2,11 +2,7 @@
 id against single envs, unknown ids, the Gymnasium ids (against a stand-in module) and reset
 options reaching the env."""
 
-import os
 import re
-import subprocess
-import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -237,70 +233,7 @@ def test_reset_options_reach_the_env():
     assert info["friction"] == 0.7 and info["cube_mass"] == 3.0
 
 
-# The Gymnasium branch against a minimal stand-in (Gymnasium is not a Debian package): its
-# registry, id grammar (Gymnasium 1.x's ENV_ID_RE; ":" in an id names a module for make) and make.
-GYMNASIUM = '''
-import importlib
-import re
-
-import numpy as np
-
-from . import spaces, vector
-
-ENV_ID_RE = re.compile(
-    r"^(?:(?P<namespace>[\\w:-]+)\\/)?(?:(?P<name>[\\w:.-]+?))(?:-v(?P<version>\\d+))?$")
-registry = {}
-
-
-def register(id, entry_point, kwargs=None):
-    assert ENV_ID_RE.fullmatch(id), id
-    registry[id] = (entry_point, kwargs or {})
-
-
-def make(id, **kwargs):
-    assert ":" not in id, "make reads 'module:name' ids as a module to import"
-    entry_point, defaults = registry[id]
-    module, name = entry_point.split(":")
-    return getattr(importlib.import_module(module), name)(**{**defaults, **kwargs})
-
-
-class Env:
-    spec = None
-    _np_random = None
-
-    def reset(self, *, seed=None, options=None):
-        if seed is not None:
-            self._np_random = np.random.default_rng(seed)
-
-
-class Wrapper(Env):
-    def __init__(self, env):
-        self.env = env
-
-
-ObservationWrapper = RewardWrapper = ActionWrapper = Wrapper
-'''
-
-SPACES = '''
-import numpy as np
-
-
-class Box:
-    def __init__(self, low, high, shape=None, dtype=np.float32):
-        self.low = np.broadcast_to(np.asarray(low, dtype=dtype), shape)
-        self.high = np.broadcast_to(np.asarray(high, dtype=dtype), shape)
-        self.shape = tuple(shape)
-        self.dtype = np.dtype(dtype)
-
-
-class Dict:
-    def __init__(self, spaces):
-        self.spaces = dict(spaces)
-
-    def __getitem__(self, key):
-        return self.spaces[key]
-'''
-
+# The Gymnasium branch against conftest.py's stand-in: its registry, id grammar and make.
 SCRIPT = '''
 import gymnasium, numpy as np, cradle
 assert cradle.HAS_GYMNASIUM
@@ -327,19 +260,8 @@ print("ok")
 '''
 
 
-def test_gymnasium_ids(tmp_path):
-    package = tmp_path / "gymnasium"
-    (package / "vector").mkdir(parents=True)
-    (package / "__init__.py").write_text(GYMNASIUM)
-    (package / "spaces.py").write_text(SPACES)
-    (package / "vector" / "__init__.py").write_text("class VectorEnv:\n    pass\n")
-    env = dict(os.environ)
-    package_root = os.path.dirname(os.path.dirname(os.path.abspath(cradle.__file__)))
-    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), package_root])
-    result = subprocess.run([sys.executable, "-c", textwrap.dedent(SCRIPT)], env=env,
-                            capture_output=True, text=True, cwd=tmp_path)
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "ok"
+def test_gymnasium_ids(with_gymnasium):
+    assert with_gymnasium(SCRIPT).strip() == "ok"
 
 
 def test_without_gymnasium_ids_still_resolve():

@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 import pickle
 
 import numpy as np
@@ -150,3 +151,18 @@ def test_train_with_async_batches(make_config):
     assert sorted(e["steps"] for e in log) == [0] * 3 + [26] * 3 + [50] * 6
     with pytest.raises(ValueError, match="--async-batch 3 must be between 1 and --envs - 1"):
         cradle.train(config, steps=64, envs=3, async_batch=3, progress_bar=False)
+
+
+def test_evaluate_films_only_when_asked(make_config):
+    config = make_config("selftouch")
+    videos = os.path.join(config["save_dir"], "videos")
+    os.makedirs(videos)  # an empty one, as an older evaluation left it
+    cradle.evaluate(config, episodes=1, duration=2, quiet=True)
+    assert not os.path.exists(videos)
+    report = cradle.evaluate(config, episodes=1, duration=2, render=True, quiet=True)
+    assert len(report["episodes"]) == 1
+    assert os.listdir(videos) == ["episode_0.mp4"]
+    cradle.evaluate(config, episodes=1, duration=2, quiet=True)
+    assert os.listdir(videos) == ["episode_0.mp4"]  # films are kept
+    with pytest.raises(ValueError, match="render must be True or False"):
+        cradle.evaluate(config, episodes=1, duration=2, render="yes")
