@@ -54,7 +54,7 @@ TEST(CliVocabulary, HelpNamesEveryFamilyAndGroupsTheCommands) {
   }
   const std::map<std::string, std::vector<std::string>> expected = {
       {"Envs", {"envs", "random", "build-scene", "model-info", "test-installation"}},
-      {"Train", {"train", "illustrate"}},
+      {"Train", {"train", "illustrate", "campaign"}},
       {"Evaluate", {"evaluate"}},
       {"Families (reference-compatible commands)", {"tma", "sami"}},
       {"Benchmarks", {"bench", "soak"}},
