@@ -184,7 +184,10 @@ void register_evaluate(CLI::App& app) {
       "Scores: self-touch = (|geoms touched by right hand| + |by left hand|) / 68, unions over "
       "the last <= 10,000 logged episodes; hand regard = mean over the 4 eye-hand pairs of the "
       "fraction of steps in view (reference), and the mean over the eyes of the fraction with "
-      "either hand in view (competition site).");
+      "either hand in view (competition site).\n"
+      "With --run DIR instead of --config: the trained policy of a run by env id (any family) on a "
+      "fresh env of its id; writes DIR/evaluation_<checkpoint>.json and, with --render, "
+      "DIR/videos/.");
   CLI::Option* config_option = cmd->add_option("--config", opts->config, "BabyBench YAML config");
   CLI::Option* run_option = cmd->add_option(
       "--run", opts->run,
