@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cradle::apps::campaign {
@@ -62,6 +63,20 @@ void write_text(const std::filesystem::path& file, const std::string& text);
 // A word for bash: as is when plain, else single-quoted.
 std::string quote(const std::string& s);
 
+// "tma", "sami" or "train" -> its kind; false for another name.
+bool parse_kind(const std::string& name, RunKind& kind);
+// The SaMI splits a run is evaluated on: train, moderate, extreme.
+const std::vector<std::string>& sami_splits();
+// "a,b" -> {"a", "b"}.
+std::vector<std::string> split_list(const std::string& text);
+// Words joined for bash, each quoted where it is not plain.
+std::string join_quoted(const std::vector<std::string>& words);
+// Output of a shell command (stdout and stderr) and whether it exited with status 0.
+std::pair<bool, std::string> capture(const std::string& command);
+std::string last_line(const std::string& text);
+// This cradle's executable: what a campaign's runs and evaluations call.
+std::string self_exe();
+
 // Every configuration of a campaign file; a one-line UserError naming FILE:LINE otherwise.
 std::vector<Line> read_campaign(const std::filesystem::path& file);
 
@@ -74,6 +89,9 @@ struct LaunchOptions {
 // The launcher's options on `launch` (shared by both spellings).
 void add_launch_options(CLI::App& launch, const std::shared_ptr<LaunchOptions>& options);
 int launch(const LaunchOptions& options);
+
+// `cradle campaign analyze`: by the kind of the tree's runs (src/apps/campaign_analyze.cc).
+int analyze(const std::string& results, const std::string& out, const std::string& baseline);
 
 // The options of `tma campaign generate` (also `campaign generate --kind tma`).
 struct TmaGenerateOptions {
