@@ -198,7 +198,7 @@ void register_evaluate(CLI::App& app) {
   cmd->add_option("--checkpoint", opts->checkpoint,
                   "With --run: final, latest, step_<n> or a .ckpt file (default: final)")
       ->needs(run_option);
-  CLI::Option* save_dir_option = cmd->add_option("--save-dir", opts->save_dir,
+  CLI::Option* save_dir_option = cmd->add_option("--out,--save-dir", opts->save_dir,
                                                  "Output folder (default: the config's save_dir)");
   save_dir_option->excludes(run_option);
   cmd->add_option("--episodes", opts->episodes, "Evaluation episodes")

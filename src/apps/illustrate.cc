@@ -346,10 +346,10 @@ void register_illustrate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "illustrate", "Train and test a policy on a MIMo sample env (the reference's illustrations)");
   cmd->add_option("--env", o->env, "reach, standup, selfbody or catch")->required();
-  cmd->add_option("--train_for", o->train_for, "Env steps of training (0: none)");
+  cmd->add_option("--train_for,--steps", o->train_for, "Env steps of training (0: none)");
   cmd->add_option("--test_for", o->test_for, "Env steps of testing");
   cmd->add_option("--save_every", o->save_every, "Env steps between saved models");
-  cmd->add_option("--algorithm", o->algorithm,
+  cmd->add_option("--algorithm,--algo", o->algorithm,
                   "PPO, SAC, TD3, DDPG or A2C (default: the --load_model checkpoint's; without "
                   "either, testing takes random actions)");
   cmd->add_option("--load_model", o->load_model, "Model checkpoint to start from");

@@ -27,7 +27,8 @@ void register_random(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("random", "Random-policy baseline in training mode (writes the log)");
   cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
-  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
+  cmd->add_option("--out,--save-dir", opts->save_dir,
+                  "Output folder (default: the config's save_dir)");
   cmd->add_option("--train_for,--train-for", opts->train_for, "Env steps to run")
       ->check(CLI::Range(1L, 1000000000L));
   cmd->add_option("--seed", opts->seed, "Seed of the env and the random policy")->check(kSeed);

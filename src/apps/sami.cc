@@ -13,6 +13,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "apps/bench_report.h"
@@ -23,6 +24,7 @@
 #include "core/image.h"
 #include "core/rng.h"
 #include "eval/video.h"
+#include "learn/meta/sami_learner.h"
 #include "sami/env.h"
 #include "sami/render.h"
 #include "sami/scene.h"
@@ -175,15 +177,25 @@ void register_learners(CLI::App& cmd) {
                                     "Train a SaMI method (TESAC, CCM, SaTESAC, SaCCM, "
                                     "SaCCMAll) on an env's training task sets");
   tr->add_option("--env", opts->train.env, "Env name (see `cradle sami info --env all`)");
-  tr->add_option("--method", opts->train.method, "TESAC, CCM, SaTESAC, SaCCM or SaCCMAll");
+  tr->add_option("--method,--algo", opts->train.method,
+                 "TESAC, CCM, SaTESAC, SaCCM or SaCCMAll (or the learner names tesac, ccm, "
+                 "satesac, saccm, saccm_all)");
   tr->add_option("--seed", opts->train.seed, "Seed")->check(kSeed);
   tr->add_option("--steps-per-env", opts->train.steps_per_env,
                  "Env steps per training env (default: the env's, 500000; PandaPush 1000000)")
       ->check(CLI::Range(1L, 10'000'000'000L))
       ->default_str("");  // 0 stands for the env's budget
+  CLI::Option* steps =
+      tr->add_option("--steps", opts->train.steps,
+                     "Env steps in all (over the training envs; rounded up to a multiple of "
+                     "their number) instead of --steps-per-env")
+          ->check(CLI::Range(1L, 100'000'000'000L))
+          ->default_str("");
+  steps->excludes("--steps-per-env");
   tr->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
   tr->add_option("--out", opts->out, "Run folder (default runs/sami/<env>_<method>_<seed>)");
   tr->add_flag("--resume", opts->train.resume, "Continue the run in --out from its checkpoint");
+  tr->add_flag("--overwrite", opts->train.overwrite, "Replace the run already in --out");
   tr->add_option("--checkpoint-every", opts->train.checkpoint_every,
                  "Env steps per training env between checkpoints")
       ->check(CLI::Range(1L, 10'000'000'000L));
@@ -205,6 +217,9 @@ void register_learners(CLI::App& cmd) {
         }
       }
     }
+    // The learner registry's names (`cradle train --algo saccm`) name the same methods.
+    if (const std::string_view m = learn::meta::sami_method(opts->train.method); !m.empty())
+      opts->train.method = std::string(m);
     opts->train.hyperparameters = parse_hp(opts->hp);
     opts->train.out = opts->out;
     opts->train.stop = stop_on({SIGINT, SIGTERM});

@@ -55,7 +55,8 @@ void register_soak(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "soak", "Vision soak: random actions on a vector of envs, evaluations with video between");
   cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
-  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
+  cmd->add_option("--out,--save-dir", opts->save_dir,
+                  "Output folder (default: the config's save_dir)");
   cmd->add_option("--steps", opts->steps, "Env steps in total")
       ->check(CLI::Range(1L, 100000000000L));
   cmd->add_option("--envs", opts->envs, "Parallel envs")->check(CLI::Range(1, 1024));

@@ -26,7 +26,7 @@ void register_test_installation(CLI::App& app) {
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "test-installation", "Check that Cradle works here: build, simulate, sense, render, encode");
-  cmd->add_option("--save-dir", opts->save_dir,
+  cmd->add_option("--out,--save-dir", opts->save_dir,
                   "Output folder (default: results/test_installation)");
   cmd->add_option("--steps", opts->steps, "Random steps after the first one")
       ->check(CLI::Range(1, 100000));

@@ -153,6 +153,7 @@ struct RunOptions {
   std::vector<std::string> teacher_params, hp;
   double nb_env_steps = 20, lr = 0, min_stump_h = 0, max_stump_h = 3, max_obstacle_spacing = 6;
   long test_every = 500000, keep_periodical_task_samples = 0, reset_frequency = 0;
+  long steps = 0;  // > 0: the budget in plain env steps (instead of --nb_env_steps)
   int nb_test_episodes = 100;
   std::uint64_t seed = 0;
   bool shuffle_dimensions = false, scale_reward = false, resume = false, overwrite = false,
@@ -306,13 +307,17 @@ void register_tma(CLI::App& app) {
   run->add_option("--exp_name", rn->exp_name, "Experiment name (default run folder)");
   add_env_options(run, rn->env, rn->body);
   rn->env_flags.add(run);
-  run->add_option("--student", rn->student, "sac | ppo (the reference presets)");
+  run->add_option("--student,--algo", rn->student, "sac | ppo (the reference presets)");
   run->add_option("--teacher", rn->teacher,
                   "Random, ADR, ALP-GMM, Covar-GMM, RIAC, Self-Paced, GoalGAN, Setter-Solver");
   run->add_option("--teacher-param", rn->teacher_params,
                   "Teacher kwarg by the reference's name, k=v (v as JSON; repeatable)");
   run->add_option("--allow_expert_knowledge", rn->expert_knowledge, "none | low | high");
   run->add_option("--nb_env_steps", rn->nb_env_steps, "Training env steps, in millions");
+  run->add_option("--steps", rn->steps, "Training env steps (plain) instead of --nb_env_steps")
+      ->check(CLI::Range(1L, static_cast<long>(kMaxMillions * 1e6)))
+      ->excludes("--nb_env_steps")
+      ->default_str("");
   run->add_option("--test_set", rn->test_set,
                   "Test set of data/teachmyagent (e.g. parametric_stumps_test_set); default: "
                   "the grid (Stump Tracks) or 100 fixed uniform tasks");
@@ -337,6 +342,8 @@ void register_tma(CLI::App& app) {
   run->add_flag("--overwrite", rn->overwrite, "Replace the run already in --out");
   run->add_flag("--no-progress", rn->no_progress, "No progress bar");
   run->callback([rn] {
+    // --steps is the budget in env steps; recorded as the reference's millions.
+    if (rn->steps > 0) rn->nb_env_steps = static_cast<double>(rn->steps) / 1e6;
     const RunOptions& ro = *rn;
     if (!(ro.nb_env_steps > 0) || !std::isfinite(ro.nb_env_steps)) {
       throw UserError("--nb_env_steps " + std::to_string(ro.nb_env_steps) +
@@ -352,20 +359,21 @@ void register_tma(CLI::App& app) {
                     ro.nb_env_steps / 1e6);
       throw UserError(text);
     }
-    train::StudentRunOptions o{.student = ro.student,
-                               .teacher = ro.teacher,
-                               .expert_knowledge = ro.expert_knowledge,
-                               .total_steps = std::lround(ro.nb_env_steps * 1e6),
-                               .test_every = ro.test_every,
-                               .nb_test_episodes = ro.nb_test_episodes,
-                               .seed = ro.seed,
-                               .keep_periodical_task_samples = ro.keep_periodical_task_samples,
-                               .shuffle_dimensions = ro.shuffle_dimensions,
-                               .scale_reward = ro.scale_reward,
-                               .reset_frequency = ro.reset_frequency,
-                               .resume = ro.resume,
-                               .overwrite = ro.overwrite,
-                               .progress_bar = !ro.no_progress};
+    train::StudentRunOptions o{
+        .student = ro.student,
+        .teacher = ro.teacher,
+        .expert_knowledge = ro.expert_knowledge,
+        .total_steps = ro.steps > 0 ? ro.steps : std::lround(ro.nb_env_steps * 1e6),
+        .test_every = ro.test_every,
+        .nb_test_episodes = ro.nb_test_episodes,
+        .seed = ro.seed,
+        .keep_periodical_task_samples = ro.keep_periodical_task_samples,
+        .shuffle_dimensions = ro.shuffle_dimensions,
+        .scale_reward = ro.scale_reward,
+        .reset_frequency = ro.reset_frequency,
+        .resume = ro.resume,
+        .overwrite = ro.overwrite,
+        .progress_bar = !ro.no_progress};
     for (const std::string& kv : ro.teacher_params) {
       const auto [k, v] = key_value("--teacher-param", kv);
       o.teacher_params[k] =

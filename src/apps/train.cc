@@ -76,7 +76,8 @@ void register_train(CLI::App& app) {
   cmd->add_option("--config", opts->config, "BabyBench YAML config (or --env)");
   cmd->add_option("--env", opts->train.env,
                   "An env id instead (`cradle envs`: babybench/..., mimo/..., tma/..., sami/...)");
-  cmd->add_option("--save-dir", opts->save_dir, "Output folder (default: the config's save_dir)");
+  cmd->add_option("--out,--save-dir", opts->save_dir,
+                  "Output folder (default: the config's save_dir)");
   cmd->add_option("--algo", opts->train.algorithm, "Learning algorithm")
       ->check(CLI::IsMember(learn::algorithm_names()))
       ->capture_default_str();
@@ -102,6 +103,7 @@ void register_train(CLI::App& app) {
          "LibTorch threads for gradient updates (0: every core for image policies, 1 otherwise)")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--seed", opts->train.seed, "Seed of everything")->check(kSeed);
+  cmd->add_flag("!--no-progress", opts->train.progress_bar, "No progress bar");
   cmd->add_flag("--resume", opts->train.resume, "Continue from <save_dir>/checkpoints/latest.ckpt");
   cmd->add_flag("--overwrite", opts->train.overwrite,
                 "Replace the run already in the folder (its checkpoints, logs and plots)");

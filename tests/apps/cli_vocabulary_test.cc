@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -36,6 +37,13 @@ std::string option_line(const std::string& help, const std::string& option) {
   const size_t at = help.find("\n  " + option);
   if (at == std::string::npos) return "";
   return help.substr(at + 3, help.find('\n', at + 1) - at - 3);
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 // Lines of `out` that start with `prefix`.
@@ -97,7 +105,8 @@ TEST(CliVocabulary, EveryHelpShowsTheDefaults) {
   EXPECT_NE(option_line(tma.out, "--teacher ").find("=ALP-GMM"), std::string::npos) << tma.out;
   const auto sami = run_cradle("sami train --help");
   ASSERT_EQ(sami.status, 0) << sami.out;
-  EXPECT_NE(option_line(sami.out, "--method ").find("=SaCCM"), std::string::npos) << sami.out;
+  EXPECT_NE(option_line(sami.out, "--method,--algo ").find("=SaCCM"), std::string::npos)
+      << sami.out;
   EXPECT_EQ(sami.out.find("{false}"), std::string::npos) << sami.out;  // --no-progress
   const auto video = run_cradle("tma video --help");
   ASSERT_EQ(video.status, 0) << video.out;
@@ -132,6 +141,60 @@ TEST(CliVocabulary, EvaluateFilmsOnlyWithRender) {
       run_cradle(evaluate + " --episodes 1 --no-render --save-dir " + (dir / "plain").string());
   ASSERT_EQ(plain.status, 0) << plain.out;
   EXPECT_TRUE(!fs::exists(dir / "plain" / "videos") || fs::is_empty(dir / "plain" / "videos"));
+  fs::remove_all(dir);
+}
+
+// One vocabulary for what every run has: the run folder (--out), the budget in plain env steps
+// (--steps), the algorithm (--algo), the seed, --resume, --overwrite and --no-progress; the
+// families' reference spellings stay as aliases.
+TEST(CliVocabulary, EveryTrainingCommandSpeaksTheSameFlags) {
+  const std::map<std::string, std::vector<std::string>> commands = {
+      {"train",
+       {"--out,--save-dir", "--steps", "--algo", "--seed", "--resume", "--overwrite",
+        "--no-progress"}},
+      {"tma run",
+       {"--out", "--steps", "--student,--algo", "--seed", "--resume", "--overwrite",
+        "--no-progress", "--nb_env_steps"}},
+      {"sami train",
+       {"--out", "--steps", "--method,--algo", "--seed", "--resume", "--overwrite", "--no-progress",
+        "--steps-per-env"}},
+      {"illustrate", {"--train_for,--steps", "--algorithm,--algo", "--seed"}}};
+  for (const auto& [command, flags] : commands) {
+    const auto help = run_cradle(command + " --help");
+    ASSERT_EQ(help.status, 0) << help.out;
+    for (const std::string& flag : flags)
+      EXPECT_NE(option_line(help.out, flag + " "), "") << command << " lacks " << flag;
+  }
+
+  const fs::path dir = cradle::test::fresh_dir("cli_vocabulary_flags");
+  // --steps is env steps in all: SaMI's three training envs get 100 each.
+  const auto sami = run_cradle(
+      "sami train --env CrippleHalfCheetah --algo tesac --steps 300 --no-progress --out " +
+      (dir / "sami").string());
+  ASSERT_EQ(sami.status, 0) << sami.out;
+  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"steps_per_env\": 100"), std::string::npos);
+  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"method\": \"TESAC\""), std::string::npos);
+  // A finished run is replaced only when asked.
+  const std::string again = "sami train --env CrippleHalfCheetah --steps 300 --no-progress --out " +
+                            (dir / "sami").string();
+  EXPECT_EQ(run_cradle(again).status, 1);
+  EXPECT_EQ(run_cradle(again + " --overwrite").status, 0);
+  // A budget in two units is refused; --steps alone is the run's length.
+  EXPECT_EQ(run_cradle("tma run --steps 1000 --nb_env_steps 0.001 --out " + (dir / "tma").string())
+                .status,
+            1);
+  const auto tma = run_cradle(
+      "tma run --algo sac --steps 1000 --test_every 1000 --nb_test_episodes 2 --no-progress "
+      "--hp learning_starts=300 --hp batch_size=32 --hp pi_layers=16 --hp qf_layers=16 --out " +
+      (dir / "tma").string());
+  ASSERT_EQ(tma.status, 0) << tma.out;
+  EXPECT_EQ(cradle::test::read_lines(dir / "tma" / "progress.csv").size(), 3u);  // 0 and 1000
+  const auto train = run_cradle(
+      "train --env mimo/reach --steps 128 --hp n_steps=64 --hp "
+      "batch_size=64 --eval-episodes 0 --no-progress --out " +
+      (dir / "train").string());
+  ASSERT_EQ(train.status, 0) << train.out;
+  EXPECT_TRUE(fs::exists(dir / "train" / "checkpoints" / "final.ckpt"));
   fs::remove_all(dir);
 }
 

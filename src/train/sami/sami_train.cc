@@ -134,12 +134,20 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     std::map<std::string, std::string> merged = saved.hyperparameters;
     for (const auto& [k, v] : hp) merged[k] = v;
     hp = merged;
-  } else if (std::filesystem::exists(run / "checkpoint.ckpt")) {
+  } else if (std::filesystem::exists(run / "checkpoint.ckpt") && !options.overwrite) {
     throw UserError("sami train: " + run.string() +
-                    " already holds a run: pass --resume to continue it, or another --out");
+                    " already holds a run: pass --resume to continue it, --overwrite to replace "
+                    "it, or another --out");
   }
+  if (options.resume && options.overwrite)
+    throw UserError("sami train: --resume and --overwrite: give one of them");
+  if (options.steps < 0) throw UserError("sami train: --steps must be positive");
   const sami::EnvId id = sami::env_from_name(env_name);
   learn::meta::method_contrast(method);  // UserError for an unknown method
+  if (options.steps > 0) {
+    const long envs = static_cast<long>(sami_training_sets(id).size());
+    steps_per_env = (options.steps + envs - 1) / envs;
+  }
   if (steps_per_env == 0) steps_per_env = id == sami::EnvId::kPandaPush ? 1'000'000 : 500'000;
   if (steps_per_env < 0) throw UserError("sami train: --steps-per-env must be positive");
   if (options.checkpoint_every < 1)
@@ -161,7 +169,25 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   ContextSac learner(method, spec.obs_size, spec.action_size, config, seed);
   TrajectoryReplay replay(n, config.buffer_size, spec.horizon, spec.obs_size, spec.action_size);
   Rng rng(seed ^ 0x5a4d49ULL);
-  std::filesystem::create_directories(run);
+  {
+    std::error_code ec;
+    if (options.overwrite) {
+      // The files a run and its evaluations write; anything else in the folder stays.
+      for (const auto& entry : std::filesystem::directory_iterator(run, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name == "run.json" || name == "progress.csv" || name.starts_with("checkpoint.ckpt") ||
+            name.starts_with("progress.") || name.starts_with("eval_") ||
+            name.starts_with("contexts_")) {
+          std::filesystem::remove_all(entry.path(), ec);
+        }
+      }
+    }
+    std::filesystem::create_directories(run, ec);
+    if (ec || !std::filesystem::is_directory(run)) {
+      throw UserError("sami train: cannot create the run folder '" + run.string() +
+                      "': " + (ec ? ec.message() : "a file of that name is in the way"));
+    }
+  }
   const std::filesystem::path checkpoint = run / "checkpoint.ckpt";
   const std::filesystem::path progress = run / "progress.csv";
 

@@ -26,9 +26,11 @@ struct SamiTrainOptions {
   std::string method = "SaCCM";
   std::uint64_t seed = 0;  // on resume the run's (run.json)
   long steps_per_env = 0;  // 0: SaMI's budget (500,000; PandaPush 1,000,000)
+  long steps = 0;          // > 0: env steps in all instead (rounded up to a multiple of the envs)
   std::map<std::string, std::string> hyperparameters;
   std::filesystem::path out;        // run folder; empty: runs/sami/<env>_<method>_<seed>
   bool resume = false;              // continue the run in `out` from its checkpoint
+  bool overwrite = false;           // replace a run already in `out` (else refused)
   long checkpoint_every = 100'000;  // env steps per training env between checkpoints
   long report_every = 0;            // vector steps between progress rows (0: one episode length)
   bool progress_bar = true;
