@@ -417,7 +417,9 @@ std::string done_by_files(const SeedRun& r) {
       // The whole budget (steps per env × training sets) in progress.csv, then every evaluation.
       std::ifstream in(r.dir / "run.json");
       const nlohmann::json run = nlohmann::json::parse(in, nullptr, false);
-      if (!run.is_object() || !run.contains("steps_per_env") || !run.contains("training_sets")) {
+      // A damaged run.json is no finished run (the seed runs again and its run says why).
+      if (!run.is_object() || !run.contains("steps_per_env") || !run.contains("training_sets") ||
+          !run["steps_per_env"].is_number_integer() || !run["training_sets"].is_number_integer()) {
         return "";
       }
       const long total = run["steps_per_env"].get<long>() * run["training_sets"].get<long>();
