@@ -4,37 +4,10 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "sami/envs/env_def.h"
 #include "sami/locomotion.h"
-#include "sami/panda.h"
 
 namespace cradle::sami {
-namespace {
-
-Robot robot_of(EnvId id) {
-  switch (id) {
-    case EnvId::kHalfCheetah:
-    case EnvId::kCrippleHalfCheetah:
-      return Robot::kHalfCheetah;
-    case EnvId::kAnt:
-    case EnvId::kCrippleAnt:
-      return Robot::kAnt;
-    case EnvId::kHopper:
-    case EnvId::kCrippleHopper:
-      return Robot::kHopper;
-    case EnvId::kWalker:
-    case EnvId::kCrippleWalker:
-    case EnvId::kWalkerHopper:
-      return Robot::kWalker;
-    case EnvId::kSlimHumanoid:
-    case EnvId::kHumanoidStandup:
-      return Robot::kHumanoid;
-    case EnvId::kPandaPush:
-      return Robot::kPanda;
-  }
-  return Robot::kHalfCheetah;
-}
-
-}  // namespace
 
 std::string_view skill_name(Skill skill) {
   switch (skill) {
@@ -64,38 +37,18 @@ Box Spec::action_space() const {
 }
 
 Spec env_spec(EnvId id) {
+  const EnvDef& def = env_def(id);
   Spec s;
   s.id = id;
-  s.name = std::string(env_name(id));
-  s.robot = robot_of(id);
-  int obs = 0;
-  switch (s.robot) {
-    case Robot::kHalfCheetah:
-      obs = 18, s.action_size = 6, s.horizon = 1000, s.frame_skip = 5, s.dt = 0.05;
-      break;
-    case Robot::kAnt:
-      obs = id == EnvId::kCrippleAnt ? 41 : 28, s.action_size = 8, s.horizon = 2000;
-      s.frame_skip = 5, s.dt = 0.05;
-      break;
-    case Robot::kHopper:
-      obs = 11, s.action_size = 3, s.horizon = id == EnvId::kCrippleHopper ? 1000 : 2000;
-      s.frame_skip = 4, s.dt = 0.008;
-      break;
-    case Robot::kWalker:
-      obs = 17, s.action_size = 6, s.horizon = 2000, s.frame_skip = 4, s.dt = 0.008;
-      break;
-    case Robot::kHumanoid:
-      obs = 45, s.action_size = 17, s.horizon = id == EnvId::kSlimHumanoid ? 1000 : 2000;
-      s.frame_skip = 5, s.dt = 0.015, s.action_low = -0.4, s.action_high = 0.4;
-      break;
-    case Robot::kPanda:
-      s.action_size = 4, s.horizon = 50, s.frame_skip = 20, s.dt = 0.04;
-      s.keys = {{"observation", 0, 19}, {"achieved_goal", 19, 3}, {"desired_goal", 22, 3}};
-      s.obs_size = 25;
-      return s;
-  }
-  s.keys = {{"observation", 0, obs}};
-  s.obs_size = obs;
+  s.name = std::string(def.name);
+  s.keys = def.keys.empty() ? std::vector<ObsKey>{{"observation", 0, def.obs_size}} : def.keys;
+  s.obs_size = def.obs_size;
+  s.action_size = def.action_size;
+  s.action_low = def.action_low, s.action_high = def.action_high;
+  s.horizon = def.horizon;
+  s.frame_skip = def.frame_skip;
+  s.dt = def.dt;
+  s.robot = def.robot;
   return s;
 }
 
@@ -168,8 +121,9 @@ std::unique_ptr<SamiEnv> make_env(EnvId id, std::vector<TaskSet> sets, std::uint
   validate(id, sets);
   Spec spec = env_spec(id);
   if (!model) model = compile_robot(spec.robot);
-  if (id == EnvId::kPandaPush) return make_panda(std::move(spec), model, std::move(sets), seed);
-  return make_locomotion(std::move(spec), model, std::move(sets), seed, options);
+  const EnvDef& def = env_def(id);
+  if (def.make) return def.make(std::move(spec), model, std::move(sets), seed, options);
+  return make_locomotion(std::move(spec), model, std::move(sets), seed, options, def.locomotion);
 }
 
 std::unique_ptr<SamiEnv> make_env(std::string_view name, std::string_view split, std::uint64_t seed,

@@ -8,9 +8,16 @@
 #include <string>
 #include <string_view>
 
+#include "sami/envs/registry.h"
+
 namespace cradle::sami {
 
-enum class Robot { kHalfCheetah, kAnt, kHopper, kWalker, kHumanoid, kPanda };
+// The robots of the registration table (sami/envs/registry.h), in its order.
+enum class Robot {
+#define CRADLE_SAMI_ROBOT_ENUMERATOR(robot) robot,
+  CRADLE_SAMI_ROBOTS(CRADLE_SAMI_ROBOT_ENUMERATOR)
+#undef CRADLE_SAMI_ROBOT_ENUMERATOR
+};
 
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }

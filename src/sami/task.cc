@@ -8,78 +8,10 @@
 #include <set>
 
 #include "core/error.h"
+#include "sami/envs/env_def.h"
 
 namespace cradle::sami {
 namespace {
-
-constexpr std::array<EnvId, kEnvCount> kAll = {EnvId::kHalfCheetah,
-                                               EnvId::kAnt,
-                                               EnvId::kHopper,
-                                               EnvId::kWalker,
-                                               EnvId::kSlimHumanoid,
-                                               EnvId::kHumanoidStandup,
-                                               EnvId::kCrippleHalfCheetah,
-                                               EnvId::kCrippleAnt,
-                                               EnvId::kCrippleHopper,
-                                               EnvId::kCrippleWalker,
-                                               EnvId::kWalkerHopper,
-                                               EnvId::kPandaPush};
-constexpr std::array<std::string_view, kEnvCount> kNames = {"HalfCheetah",
-                                                            "Ant",
-                                                            "Hopper",
-                                                            "Walker",
-                                                            "SlimHumanoid",
-                                                            "HumanoidStandup",
-                                                            "CrippleHalfCheetah",
-                                                            "CrippleAnt",
-                                                            "CrippleHopper",
-                                                            "CrippleWalker",
-                                                            "WalkerHopper",
-                                                            "PandaPush"};
-
-using Values = std::vector<double>;
-using Cripples = std::vector<std::vector<int>>;
-
-// The four mass x damping quadrants of a low and a high value list.
-std::vector<TaskSet> quadrants(const Values& low, const Values& high) {
-  std::vector<TaskSet> sets;
-  for (const Values* m : {&low, &high}) {
-    for (const Values* d : {&low, &high}) sets.push_back({.mass = *m, .damping = *d});
-  }
-  return sets;
-}
-
-// Cripple envs: one set per mass group, each with the same cripple choices.
-std::vector<TaskSet> mass_groups(const std::vector<Values>& groups, const Cripples& cripple,
-                                 bool mask = true) {
-  std::vector<TaskSet> sets;
-  for (const Values& m : groups) sets.push_back({.mass = m, .cripple = cripple, .mask = mask});
-  return sets;
-}
-
-// Every pair {a, b} with a from `first` and b from `second`, ascending.
-Cripples pairs(const std::vector<int>& first, const std::vector<int>& second) {
-  Cripples out;
-  for (int a : first) {
-    for (int b : second) {
-      if (a < b) out.push_back({a, b});
-      if (b < a) out.push_back({b, a});
-    }
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-Cripples singles(const std::vector<int>& units) {
-  Cripples out;
-  for (int u : units) out.push_back({u});
-  return out;
-}
-
-const Values kTrainMass = {0.75, 0.85, 1.0, 1.15, 1.25};
-const std::vector<Values> kModerateMass = {{0.4, 0.5}, {1.5, 1.6}};
-const std::vector<Values> kExtremeMass = {{0.2, 0.3}, {1.7, 1.8}};
 
 std::string number_text(double v) {
   char buf[32];
@@ -158,42 +90,52 @@ T read(const YAML::Node& node, const std::string& where, const char* expected) {
 
 }  // namespace
 
-std::string_view env_name(EnvId id) { return kNames[static_cast<int>(id)]; }
-std::span<const EnvId> all_envs() { return kAll; }
+std::vector<TaskSet> quadrants(const Values& low, const Values& high) {
+  std::vector<TaskSet> sets;
+  for (const Values* m : {&low, &high}) {
+    for (const Values* d : {&low, &high}) sets.push_back({.mass = *m, .damping = *d});
+  }
+  return sets;
+}
+
+std::vector<TaskSet> mass_groups(const std::vector<Values>& groups, const Cripples& cripple,
+                                 bool mask) {
+  std::vector<TaskSet> sets;
+  for (const Values& m : groups) sets.push_back({.mass = m, .cripple = cripple, .mask = mask});
+  return sets;
+}
+
+Cripples pairs(const std::vector<int>& first, const std::vector<int>& second) {
+  Cripples out;
+  for (int a : first) {
+    for (int b : second) {
+      if (a < b) out.push_back({a, b});
+      if (b < a) out.push_back({b, a});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+Cripples singles(const std::vector<int>& units) {
+  Cripples out;
+  for (int u : units) out.push_back({u});
+  return out;
+}
+
+std::string_view env_name(EnvId id) { return env_def(id).name; }
 
 EnvId env_from_name(std::string_view name) {
-  for (EnvId id : kAll) {
+  for (EnvId id : all_envs()) {
     if (env_name(id) == name) return id;
   }
   std::string list;
-  for (std::string_view n : kNames) list += (list.empty() ? "" : ", ") + std::string(n);
+  for (EnvId id : all_envs()) list += (list.empty() ? "" : ", ") + std::string(env_name(id));
   throw UserError("unknown SaMI env '" + std::string(name) + "'; expected one of " + list);
 }
 
-Varies env_varies(EnvId id) {
-  switch (id) {
-    case EnvId::kHalfCheetah:
-    case EnvId::kAnt:
-    case EnvId::kHopper:
-    case EnvId::kWalker:
-    case EnvId::kSlimHumanoid:
-    case EnvId::kHumanoidStandup:
-      return {.mass = true, .damping = true};
-    case EnvId::kCrippleHalfCheetah:
-      return {.mass = true, .cripple_units = 6, .max_crippled = 2};
-    case EnvId::kCrippleAnt:
-      return {.mass = true, .cripple_units = 4, .max_crippled = 2};
-    case EnvId::kCrippleHopper:
-      return {.mass = true, .cripple_units = 3, .max_crippled = 2};
-    case EnvId::kCrippleWalker:
-      return {.mass = true, .cripple_units = 6, .max_crippled = 2};
-    case EnvId::kWalkerHopper:
-      return {.mass = true, .cripple_units = 6, .max_crippled = 3};
-    case EnvId::kPandaPush:
-      return {.cells = true};
-  }
-  return {};
-}
+Varies env_varies(EnvId id) { return env_def(id).varies; }
 
 std::string_view split_name(Split split) {
   switch (split) {
@@ -221,18 +163,6 @@ std::string joints_text(const std::vector<int>& joints, std::string_view separat
   return out;
 }
 
-std::vector<std::array<double, 2>> panda_cells(Split split) {
-  switch (split) {
-    case Split::kTrain:
-      return {{0.1, 1}, {0.1, 5}, {0.1, 10}, {1, 1}, {5, 1}, {10, 1}};
-    case Split::kModerate:
-      return {{1, 5}, {1, 10}, {5, 5}, {5, 10}, {10, 5}, {10, 10}};
-    case Split::kExtreme:
-      return {{0.1, 30}, {1, 30}, {5, 30}, {10, 30}, {30, 1}, {30, 5}, {30, 10}, {30, 30}};
-  }
-  return {};
-}
-
 std::vector<TaskSet> one_set_per_env(std::vector<TaskSet> sets) {
   if (sets.size() != 1) return sets;
   const TaskSet& one = sets[0];
@@ -253,77 +183,7 @@ std::vector<TaskSet> one_set_per_env(std::vector<TaskSet> sets) {
   return out.empty() ? sets : out;
 }
 
-std::vector<TaskSet> split_sets(EnvId id, Split split) {
-  const int s = static_cast<int>(split);
-  switch (id) {
-    // Mass x damping quadrants of the DOMINO/CaDM settings (§7.1 table (b)).
-    case EnvId::kHalfCheetah: {
-      const Values lo[3] = {{0.75, 0.85}, {0.4, 0.5}, {0.2, 0.3}};
-      const Values hi[3] = {{1.0, 1.15, 1.25}, {1.5, 1.6}, {1.7, 1.8}};
-      return quadrants(lo[s], hi[s]);
-    }
-    case EnvId::kAnt: {
-      // The extreme test of SaMI's tools/rewrite_config.py: m in 0.40..0.60 by 0.05, d = 1.
-      if (split == Split::kExtreme) {
-        return {{.mass = {0.4, 0.45, 0.5, 0.55, 0.6}, .damping = {1.0}}};
-      }
-      const Values lo[2] = {{0.75, 0.85}, {0.4, 0.5}};
-      const Values hi[2] = {{1.0, 1.15, 1.25}, {1.5, 1.6}};
-      return quadrants(lo[s], hi[s]);
-    }
-    // The script gives Hopper's extreme sets equal to its moderate ones; Walker follows Hopper.
-    case EnvId::kHopper:
-    case EnvId::kWalker: {
-      if (split == Split::kTrain) return quadrants({0.5, 0.75}, {1.0, 1.25, 1.5});
-      return quadrants({0.25, 0.375}, {1.75, 2.0});
-    }
-    case EnvId::kSlimHumanoid:
-    case EnvId::kHumanoidStandup: {
-      const Values lo[3] = {{0.8, 0.9}, {0.6, 0.7}, {0.4, 0.5}};
-      const Values hi[3] = {{1.0, 1.15, 1.25}, {1.5, 1.6}, {1.7, 1.8}};
-      return quadrants(lo[s], hi[s]);
-    }
-    // Cripple envs vary mass only; the README's qualitative cripple splits.
-    case EnvId::kCrippleHalfCheetah: {
-      if (split == Split::kTrain) return mass_groups({kTrainMass}, singles({3, 4, 5}));
-      if (split == Split::kModerate) return mass_groups(kModerateMass, singles({0, 1, 2}));
-      // Two distinct joints of all six: the env's two-joint mode draws both from one set (it
-      // cannot ask for one front and one back), and SaMI's own extreme demo cripples 4 and 5.
-      const std::vector<int> all = {0, 1, 2, 3, 4, 5};
-      return mass_groups(kExtremeMass, pairs(all, all));
-    }
-    case EnvId::kCrippleAnt: {
-      if (split == Split::kTrain) return mass_groups({kTrainMass}, singles({0, 1, 2, 3}));
-      if (split == Split::kModerate) return mass_groups(kModerateMass, singles({0, 1, 2, 3}));
-      return mass_groups(kExtremeMass, pairs({0, 1, 2, 3}, {0, 1, 2, 3}));
-    }
-    case EnvId::kCrippleHopper: {
-      if (split == Split::kTrain) return mass_groups({kTrainMass}, {});
-      if (split == Split::kModerate) return mass_groups(kModerateMass, {});
-      return mass_groups(kExtremeMass, singles({0, 1, 2}));
-    }
-    case EnvId::kCrippleWalker: {
-      if (split == Split::kTrain) return mass_groups({kTrainMass}, singles({0, 1, 2}));
-      if (split == Split::kModerate) return mass_groups(kModerateMass, singles({3, 4, 5}));
-      return mass_groups(kExtremeMass, pairs({0, 1, 2}, {3, 4, 5}));
-    }
-    // The whole right leg "disabled" as SaMI's mode [3] does it (geometry only, no mask).
-    case EnvId::kWalkerHopper: {
-      if (split == Split::kTrain) return mass_groups({kTrainMass}, {{0, 1, 2}}, false);
-      if (split == Split::kModerate) return mass_groups(kModerateMass, singles({0, 1, 2}));
-      std::vector<TaskSet> sets = mass_groups(kExtremeMass, {{3, 4, 5}}, false);
-      for (TaskSet& t : mass_groups(kExtremeMass, singles({3, 4, 5}))) sets.push_back(t);
-      return sets;
-    }
-    // One sub-env per friction x mass cell, as SaMI's DummyVecEnv.
-    case EnvId::kPandaPush: {
-      std::vector<TaskSet> sets;
-      for (const auto& cell : panda_cells(split)) sets.push_back({.cells = {cell}});
-      return sets;
-    }
-  }
-  return {};
-}
+std::vector<TaskSet> split_sets(EnvId id, Split split) { return env_def(id).split_sets(split); }
 
 void validate(EnvId id, const std::vector<TaskSet>& sets) {
   const std::string env(env_name(id));

@@ -10,23 +10,19 @@
 #include <string_view>
 #include <vector>
 
+#include "sami/envs/registry.h"
+
 namespace cradle::sami {
 
+// The envs of the registration table (sami/envs/registry.h), in its order.
 enum class EnvId {
-  kHalfCheetah,
-  kAnt,
-  kHopper,
-  kWalker,
-  kSlimHumanoid,
-  kHumanoidStandup,
-  kCrippleHalfCheetah,
-  kCrippleAnt,
-  kCrippleHopper,
-  kCrippleWalker,
-  kWalkerHopper,
-  kPandaPush,
+#define CRADLE_SAMI_ENV_ENUMERATOR(id, file) id,
+  CRADLE_SAMI_ENVS(CRADLE_SAMI_ENV_ENUMERATOR)
+#undef CRADLE_SAMI_ENV_ENUMERATOR
 };
-inline constexpr int kEnvCount = 12;
+#define CRADLE_SAMI_ENV_ONE(id, file) +1
+inline constexpr int kEnvCount = 0 CRADLE_SAMI_ENVS(CRADLE_SAMI_ENV_ONE);
+#undef CRADLE_SAMI_ENV_ONE
 
 std::string_view env_name(EnvId id);
 std::span<const EnvId> all_envs();
