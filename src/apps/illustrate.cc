@@ -53,6 +53,7 @@ struct IllustrateOptions {
   bool use_muscles = false;
   bool stochastic = false;
   bool jitter = false, position_inaccurate = false, palm_up = false;  // catch only
+  bool overwrite = false;  // replace the models already saved under --save_model
   int envs = 1;
   std::uint64_t seed = 0;
   std::vector<std::string> hp;
@@ -125,7 +126,16 @@ void run(const IllustrateOptions& o) {
     const size_t eq = kv.find('=');
     if (eq == std::string::npos || eq == 0)
       throw UserError("--hp '" + kv + "': expected name=value");
-    hyperparameters[kv.substr(0, eq)] = kv.substr(eq + 1);
+    // The same name twice would keep only one of the values, silently.
+    if (!hyperparameters.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
+      throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
+  }
+  // Models trained before under this name are never replaced silently.
+  const fs::path saved = fs::path("models") / o.env / o.save_model;
+  if (o.train_for > 0 && !o.overwrite && fs::exists(saved / "progress.csv")) {
+    throw UserError("'" + saved.string() +
+                    "' holds models trained before; give --overwrite to replace them or another "
+                    "--save_model");
   }
   if (!o.load_model.empty()) {
     const learn::CheckpointInfo info = learn::read_checkpoint_info(o.load_model);
@@ -194,6 +204,16 @@ void run(const IllustrateOptions& o) {
   // Training: checkpoints model_<k>.ckpt after every save_every steps, progress.csv per update.
   if (o.train_for > 0) {
     std::error_code ec;
+    // --overwrite: the earlier run's models and curves go (after --load_model was read).
+    if (o.overwrite) {
+      for (const auto& entry : fs::directory_iterator(dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name.starts_with("model_") || name == "progress.csv" || name.ends_with(".png") ||
+            name == "figures.json")
+          fs::remove(entry.path(), ec);
+      }
+      ec.clear();
+    }
     fs::create_directories(dir, ec);
     if (ec) throw UserError("cannot create '" + dir.string() + "': " + ec.message());
     std::ofstream csv(dir / "progress.csv");
@@ -354,6 +374,7 @@ void register_illustrate(CLI::App& app) {
                   "either, testing takes random actions)");
   cmd->add_option("--load_model", o->load_model, "Model checkpoint to start from");
   cmd->add_option("--save_model", o->save_model, "Name: models are saved in models/<env>/<name>");
+  cmd->add_flag("--overwrite", o->overwrite, "Replace the models saved before under --save_model");
   cmd->add_flag("--render_video", o->render_video, "Film every test episode (episode_<i>.mp4)");
   cmd->add_flag("--use_muscles,--use_muscle", o->use_muscles,
                 "Muscle actuation instead of spring-damper motors");
