@@ -154,6 +154,8 @@ class BabyBenchEnv(_EnvBase):
         buffers, overwritten by the next step.
       camera: the model camera render() draws ("corner", "top", "side1", "side2", "closeup",
         "eye_left", "eye_right").
+      overwrite: with training, replace a training log already in save_dir (without it such a
+        folder is refused: a finished run's log is never replaced silently).
     """
 
     def __init__(
@@ -164,6 +166,7 @@ class BabyBenchEnv(_EnvBase):
         seed=0,
         copy_observations=True,
         camera="corner",
+        overwrite=False,
     ):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', not {render_mode!r}")
@@ -174,6 +177,10 @@ class BabyBenchEnv(_EnvBase):
         self.config = json.loads(self._config.to_json())
         self.training = bool(training)
         self._closed = False
+        log = os.path.join(self._config.save_dir, "logs", "training.jsonl")
+        if self.training and not overwrite and os.path.isfile(log) and os.path.getsize(log) > 0:
+            raise ValueError(f"{log} holds the training log of an earlier run; pass "
+                             "overwrite=True to replace it, or give another save_dir")
         self._core = _cradle.Env(self._config, self.training, int(seed), bool(copy_observations))
         self.render_mode = render_mode
         self.camera = camera

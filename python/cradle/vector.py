@@ -70,6 +70,9 @@ class VectorEnv(_VectorBase):
             raise ValueError("autoreset_mode must be 'next_step' or 'same_step'")
         if not isinstance(num_envs, numbers.Integral) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, not {num_envs!r}")
+        if not isinstance(threads, numbers.Integral) or isinstance(threads, bool) or threads < 0:
+            raise ValueError(f"threads must be a non-negative integer (0: one per env, at most the "
+                             f"cores), not {threads!r}")
         if not isinstance(procs, numbers.Integral) or procs < 0:
             raise ValueError(f"procs must be a non-negative integer, not {procs!r}")
         if not isinstance(seed, numbers.Integral) or isinstance(seed, bool) or not (

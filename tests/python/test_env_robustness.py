@@ -173,3 +173,25 @@ def test_old_gym_api_close():
     env.close()
     with pytest.raises(ValueError, match="closed"):
         env.step(np.zeros(4))
+
+
+def test_a_training_log_is_never_replaced_silently(make_config):
+    import os
+
+    import cradle
+
+    config = make_config("selftouch", max_episode_steps=3)
+    env = cradle.make_env(config, training=True)
+    env.reset(seed=0)
+    for _ in range(4):
+        env.step(np.zeros(env.action_space.shape))
+    env.close()
+    log = os.path.join(config["save_dir"], "logs", "training.jsonl")
+    before = open(log).read()
+    assert before
+    with pytest.raises(ValueError, match="holds the training log of an earlier run") as err:
+        cradle.make_env(config, training=True)
+    assert "\n" not in str(err.value)
+    assert open(log).read() == before  # nothing touched
+    cradle.make_env(config, training=False).close()  # evaluation envs write no log
+    cradle.make_env(config, training=True, overwrite=True).close()

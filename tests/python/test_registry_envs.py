@@ -178,6 +178,9 @@ def test_vector_of_an_id_options_and_errors():
         cradle.VectorEnv("mimo/reach", 2, procs=1)
     with pytest.raises(ValueError, match="closest"):
         cradle.VectorEnv("mimo/reech", 2)
+    for threads in (-5, 1.5, True, "2"):
+        with pytest.raises(ValueError, match="threads must be a non-negative integer"):
+            cradle.VectorEnv("mimo/reach", 2, threads=threads)
     # A BabyBench id makes the config's vector.
     vec = cradle.VectorEnv("BabyBench-SelfTouch", 2)
     assert vec.family == "babybench" and vec.single_action_space.shape == (30,)
