@@ -9,6 +9,9 @@
 //       L = L_policy - ent_coef * entropy + vf_coef * L_value
 //       one RMSprop step on L with the gradient norm clipped to max_grad_norm
 //   reporting the updates' mean losses about every 2,048 steps per env
+// With overlap_update=true rollout k+1 is collected during the update of rollout k, with the
+// policy from before it (on_policy.h); A2C's loss has no importance ratio, so its gradient is
+// then that of a policy one update old, uncorrected.
 #include "learn/a2c.h"
 
 #include <torch/torch.h>
@@ -32,6 +35,8 @@ void A2cConfig::bind(Hyperparameters& table) {
   table.add("rms_prop_alpha", &rms_prop_alpha, "RMSprop smoothing constant");
   table.add("rms_prop_eps", &rms_prop_eps, "RMSprop epsilon");
   table.add("normalize_advantage", &normalize_advantage, "standardise advantages per rollout");
+  table.add("overlap_update", &overlap_update,
+            "collect the next rollout while updating on this one (one update of policy lag)");
 }
 
 namespace {

@@ -24,6 +24,9 @@ struct A2cConfig {
   double rms_prop_alpha = 0.99;      // RMSprop smoothing constant (SB3 alpha in policy_kwargs)
   double rms_prop_eps = 1e-5;        // RMSprop epsilon (SB3 rms_prop_eps)
   bool normalize_advantage = false;  // standardise advantages over the rollout
+  // Collect rollout k+1 on a thread of its own while updating on rollout k (learn/on_policy.h),
+  // as PPO's; with A2C's 5-step rollouts the thread handoff costs about what it saves.
+  bool overlap_update = false;
 
   void bind(Hyperparameters& table);
 };

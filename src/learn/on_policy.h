@@ -12,6 +12,29 @@
 //     the algorithm's update on the rollout
 //     every report_every iterations (and at the end): report the updates' mean losses, the
 //     episodes that ended and the speed
+//
+// With overlap_update (off by default) rollout k+1 is collected on a thread of its own while the
+// update of rollout k runs (learn_overlapped, on_policy.cc), in two rollout buffers in turn:
+//   collect rollout 0 with the actor copy (= the initial policy)
+//   for k = 0, 1, ...:  (boundary k: nothing runs; the policy holds every update before k)
+//     budget spent: the update on rollout k, report, return
+//     every report_every rollouts: report (steps and episodes through rollout k, the losses of
+//       the updates since the last report); it says stop: the update on rollout k, return
+//     copy the policy's parameters into the actor copy
+//     collector thread: rollout k+1 with the copy (its own generator, LibTorch at
+//       torch_threads) into the other buffer; meanwhile this thread: the update on rollout k (at
+//       update_threads); wait for both
+// So collection k+1 always acts with the parameters after update k-1: one update of policy lag,
+// fixed whatever thread finishes first (PPO's ratio divides by the log-probabilities recorded at
+// collection, an importance ratio that stays right under the lag, as APPO/IMPALA's lag-1). Only
+// the collector touches the envs, the collector and the statistics (observation, return), and
+// only the update the policy, optimiser and learner generator, so a run is bitwise repeatable
+// for a seed and env count. An iteration takes max(collect, update) instead of their sum.
+// Reports come at the same steps as the synchronous loop's, before the rollout's update: their
+// losses are the previous update's (the first report of a learn() call has none, and the update
+// that follows a report saying stop is in none); the one at the end of the budget has its own.
+// learn() returns with no rollout in flight and every collected rollout trained on, at the step
+// the synchronous loop would: checkpoints and --resume are as exact as without overlap.
 #pragma once
 
 #include <torch/torch.h>
@@ -47,6 +70,8 @@ struct OnPolicyLoop {
   long report_every = 1;  // rollouts (and updates) per progress report
   // Rewards scaled by the return normaliser (learn/return_normalizer.h), after the reward hook.
   bool normalize_returns = false;
+  // Collect the next rollout while updating on this one (learn_overlapped, see the top).
+  bool overlap_update = false;
 };
 
 // Every setting of an on-policy learner: the algorithm's own (`Own`, with a bind(table)), the
@@ -79,6 +104,7 @@ OnPolicySettings<Own> parse_on_policy_settings(const LearnerOptions& options) {
   settings.loop.n_steps = own.n_steps;
   settings.loop.gamma = own.gamma;
   settings.loop.gae_lambda = own.gae_lambda;
+  settings.loop.overlap_update = own.overlap_update;
   return settings;
 }
 
@@ -113,6 +139,7 @@ class OnPolicyLearner : public Learner {
   std::string config_text() const override { return text_; }
 
   void learn(long total_steps, const ProgressFn& on_progress) override {
+    if (loop_.overlap_update) return learn_overlapped(total_steps, on_progress);
     using Clock = std::chrono::steady_clock;
     const auto seconds = [](Clock::time_point from, Clock::time_point to) {
       return std::chrono::duration<double>(to - from).count();
@@ -134,10 +161,10 @@ class OnPolicyLearner : public Learner {
 
       // Collect a rollout with the current policy, then GAE advantages and value targets.
       const Clock::time_point collect_start = Clock::now();
-      collector_.collect(policy_, generator_, buffer_);
-      steps_ += static_cast<long>(buffer_.rows()) * world_size(sync_.get());  // every rank's
+      collector_.collect(policy_, generator_, buffer());
+      steps_ += static_cast<long>(buffer().rows()) * world_size(sync_.get());  // every rank's
       pipeline_.merge_statistics(sync_.get());
-      buffer_.compute_returns_and_advantages(loop_.gamma, loop_.gae_lambda);
+      buffer().compute_returns_and_advantages(loop_.gamma, loop_.gae_lambda);
 
       // The algorithm's update on it.
       const Clock::time_point update_start = Clock::now();
@@ -230,6 +257,7 @@ class OnPolicyLearner : public Learner {
         sync_(options.sync) {
     // Data-parallel: every rank starts from rank 0's parameters.
     broadcast_tensor(sync_.get(), parameters_.tensor());
+    if (loop_.overlap_update) start_overlap(env, settings.policy);
   }
 
   // The update on the rollout in buffer() (advantages and returns computed); returns its losses
@@ -245,12 +273,13 @@ class OnPolicyLearner : public Learner {
   };
   Batch evaluate(const torch::Tensor& rows, bool normalize_advantage) {
     Batch b;
-    const ObsBatch observations = buffer_.observations.select(rows);
-    b.actions = buffer_.actions.index_select(0, rows);
-    b.old_log_probs = buffer_.log_probs.index_select(0, rows);
-    b.old_values = buffer_.values.index_select(0, rows);
-    b.returns = buffer_.returns.index_select(0, rows);
-    b.advantages = buffer_.advantages.index_select(0, rows);
+    const RolloutBuffer& rollout = buffer();  // with overlap_update, the other one is filling
+    const ObsBatch observations = rollout.observations.select(rows);
+    b.actions = rollout.actions.index_select(0, rows);
+    b.old_log_probs = rollout.log_probs.index_select(0, rows);
+    b.old_values = rollout.values.index_select(0, rows);
+    b.returns = rollout.returns.index_select(0, rows);
+    b.advantages = rollout.advantages.index_select(0, rows);
     if (normalize_advantage && rows.size(0) > 1) b.advantages = standardize(b.advantages);
     b.out = policy_->forward(observations);
     b.log_probs = policy_->log_prob(b.out.mean, b.actions);
@@ -284,7 +313,8 @@ class OnPolicyLearner : public Learner {
   // The optimiser the algorithm built on parameters() (it must outlive the learn() calls): its
   // learning rate follows the schedule, and checkpoints hold its state.
   void use_optimizer(torch::optim::Optimizer& optimizer) { optimizer_ = &optimizer; }
-  RolloutBuffer& buffer() { return buffer_; }
+  // The rollout the update reads (with overlap_update, the two buffers take turns).
+  RolloutBuffer& buffer() { return *updating_; }
   GaussianActorCritic& policy() { return policy_; }
   PackedParameters& parameters() { return parameters_; }
   at::Generator& generator() { return generator_; }
@@ -292,6 +322,17 @@ class OnPolicyLearner : public Learner {
   GradSync* sync() const { return sync_.get(); }
 
  private:
+  // overlap_update: the actor copy and the second buffer; UserError for a data-parallel run.
+  void start_overlap(const VecEnv& env, const PolicyConfig& policy);
+  // learn() with overlap_update (see the top).
+  void learn_overlapped(long total_steps, const ProgressFn& on_progress);
+  // The learning rate of the iteration that starts at `steps`: constant, or annealed linearly.
+  double learning_rate_at(long steps, long total_steps) const {
+    if (!loop_.anneal_lr) return loop_.learning_rate;
+    return loop_.learning_rate *
+           (1.0 - static_cast<double>(steps) / static_cast<double>(total_steps));
+  }
+
   const std::string algorithm_;
   const std::string text_;  // every value, "name = value" lines
   const OnPolicyLoop loop_;
@@ -303,6 +344,11 @@ class OnPolicyLearner : public Learner {
   PackedParameters parameters_;                   // policy_'s parameters, packed for the optimiser
   torch::optim::Optimizer* optimizer_ = nullptr;  // the algorithm's, on parameters_
   RolloutBuffer buffer_;
+  // overlap_update: the second rollout buffer and the collector thread's copy of the policy
+  // (LibTorch modules may not be read while the optimiser writes them); empty otherwise.
+  std::unique_ptr<RolloutBuffer> second_buffer_;
+  GaussianActorCritic actor_{nullptr};
+  RolloutBuffer* updating_ = &buffer_;
   std::unique_ptr<ReturnNormalizer> returns_;  // null: normalize_returns off
   RolloutCollector collector_;
   ObsBatch scratch_;  // one row, for act()

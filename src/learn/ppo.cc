@@ -9,6 +9,9 @@
 //       L_value = mean((R - V(s))^2)            (V optionally clipped around V_old)
 //       L = L_clip - ent_coef * entropy + vf_coef * L_value
 //       one Adam step on L with the gradient norm clipped to max_grad_norm
+// With overlap_update=true the collection of rollout k+1 runs on its own thread during the update
+// of rollout k, acting with the policy from before that update (one update of lag; pi_old in r is
+// the policy that collected, whose log-probabilities the buffer holds). See on_policy.h.
 #include "learn/ppo.h"
 
 #include <torch/torch.h>
@@ -39,6 +42,8 @@ void PpoConfig::bind(Hyperparameters& table) {
   table.add("adam_eps", &adam_eps, "Adam epsilon");
   table.add("normalize_returns", &normalize_returns,
             "divide rewards by the running std of the discounted return, clip +-10");
+  table.add("overlap_update", &overlap_update,
+            "collect the next rollout while updating on this one (one update of policy lag)");
 }
 
 namespace {

@@ -35,6 +35,10 @@ struct PpoConfig {
   // Train on rewards divided by the running std of the discounted return, clipped to +-10
   // (VecNormalize norm_reward; learn/return_normalizer.h). Its statistics are checkpointed.
   bool normalize_returns = false;
+  // Collect rollout k+1 on a thread of its own while updating on rollout k (learn/on_policy.h):
+  // rollouts act with the policy one update old, each iteration takes max(collect, update)
+  // instead of their sum. Deterministic for a seed and env count; off = SB3's loop.
+  bool overlap_update = false;
 
   void bind(Hyperparameters& table);
 };
