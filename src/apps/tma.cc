@@ -137,6 +137,9 @@ struct EnvFlags {
 
 // Whether the run folder's run.json records body or Parkour options.
 bool run_has_env_options(const std::filesystem::path& dir) {
+  // Only a readable file counts; the resume itself names a damaged one.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(dir / "run.json", ec)) return false;
   std::ifstream in(dir / "run.json");
   if (!in) return false;
   const nlohmann::json run = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -32,6 +33,7 @@
 #include "learn/vector_env.h"
 #include "teach/registry.h"
 #include "tma/render.h"
+#include "train/run_json.h"
 
 extern char** environ;
 
@@ -322,17 +324,13 @@ envs::ResetOptions test_task(const fs::path& file, int k) {
 // One deterministic episode of the run's latest checkpoint on test task K, rendered to a video.
 void video(const VideoOptions& o) {
   const fs::path dir = o.run;
-  std::ifstream run_file(dir / "run.json");
-  if (!run_file) throw UserError("no run.json in " + dir.string() + " (expected a run folder)");
-  nlohmann::json run;
-  try {
-    run = nlohmann::json::parse(run_file);
-  } catch (const std::exception&) {
-    throw UserError((dir / "run.json").string() + " is not JSON");
-  }
-  const nlohmann::json args = run.value("arguments", nlohmann::json::object());
-  const std::string env_name = args.value("env", std::string("stump-tracks"));
-  const std::string body = args.value("embodiment", std::string("old_classic_bipedal"));
+  // The run's env, body and options, every key checked (a damaged run.json is one line).
+  const train::RunJson run(dir / "run.json", "the run.json of a `cradle tma run` run");
+  const train::RunJson args = run.object("arguments");
+  const std::string env_name = args.string("env");
+  const std::string body = args.string("embodiment");
+  std::map<std::string, std::string> env_options;
+  if (args.has("env_options")) env_options = args.string_map("env_options");
   const envs::ResetOptions task = test_task(dir / "test_set.csv", o.test_task);
   const fs::path ckpt = dir / "checkpoints" / "latest.ckpt";
   if (!fs::exists(ckpt)) throw UserError("no checkpoint " + ckpt.string() + " (train first)");
@@ -345,9 +343,7 @@ void video(const VideoOptions& o) {
   tma::TmaOptions options{
       .env = tma::parse_env_id(env_name), .body = body, .max_episode_steps = o.steps};
   // The run's body and Parkour options (`tma run --motors_torque ...`), as given.
-  for (const auto& [name, value] : args.value("env_options", nlohmann::json::object()).items()) {
-    tma::set_option(options, name, value.get<std::string>());
-  }
+  for (const auto& [name, value] : env_options) tma::set_option(options, name, value);
   learn::ThreadedVecEnv vec(
       1, [&](int) { return std::make_unique<envs::TmaEnvAdapter>(options); }, 1);
   std::unique_ptr<learn::Learner> learner = learn::make_learner(info.algorithm, vec, lo);

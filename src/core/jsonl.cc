@@ -86,6 +86,10 @@ void JsonlWriter::flush(bool sync) {
 }
 
 std::vector<nlohmann::json> read_jsonl(const std::filesystem::path& file, const JsonlCheck& check) {
+  // A folder opens as a stream but fails on the first read with a library message: named here.
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw UserError(file.string() + " is a folder; expected a JSON-lines file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw UserError("cannot read " + file.string());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

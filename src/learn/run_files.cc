@@ -196,6 +196,8 @@ ProgressCut cut_progress(const fs::path& csv, const std::string& header, long st
   ProgressCut result;
   std::error_code ec;
   if (!fs::exists(csv, ec)) return result;
+  if (fs::is_directory(csv, ec))
+    throw UserError(csv.string() + " is a folder; expected the run's progress.csv");
   const std::string text = read_all(csv);
   std::string_view torn;
   const std::vector<std::string_view> lines = split_lines(text, torn);

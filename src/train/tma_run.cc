@@ -252,6 +252,10 @@ ResumePoint read_resume_point(const fs::path& file) {
                 .student_resets = static_cast<int>(std::min(j.count("student_resets"), 1L << 30)),
                 .evaluation = static_cast<int>(std::min(j.count("evaluation"), 1L << 30)),
                 .wall_s = j.number("wall_s")};
+  if (p.wall_s < 0) {
+    throw UserError(j.where() + ": \"wall_s\" is " + std::to_string(p.wall_s) +
+                    "; expected seconds >= 0");
+  }
   const RunJson sizes = j.object("sizes");
   for (const char* name : kLogs) p.sizes[name] = sizes.unsigned_integer(name);
   return p;
