@@ -19,6 +19,11 @@ const std::vector<std::string>& algorithm_names() {
   return names;
 }
 
+std::vector<std::string> extra_report_keys(std::string_view algorithm) {
+  if (!meta::sami_method(algorithm).empty()) return {"sance_loss", "sance_weight"};
+  return {};
+}
+
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options) {
   if (algorithm == "ppo") return make_ppo(env, options);

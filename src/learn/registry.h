@@ -21,4 +21,9 @@ const std::vector<std::string>& algorithm_names();
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options);
 
+// The report keys (TrainStats::losses) an algorithm adds to those every run logs, in order: a
+// run's progress.csv gives each a losses/<key> column (SaMI's methods: "sance_loss",
+// "sance_weight"; the others none).
+std::vector<std::string> extra_report_keys(std::string_view algorithm);
+
 }  // namespace cradle::learn

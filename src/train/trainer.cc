@@ -409,8 +409,11 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   }
   const fs::path csv_file = dir / "logs" / "progress.csv";
   std::string header;
-  for (size_t c = 0; c < std::size(kColumns); ++c)
-    header += (c ? "," : "") + std::string(kColumns[c]);
+  // The learner's own report keys follow the common columns (SaMI's: its SaNCE loss and weight).
+  std::vector<std::string> columns(std::begin(kColumns), std::end(kColumns));
+  const std::vector<std::string> extra = extra_report_keys(algorithm);
+  for (const std::string& key : extra) columns.push_back("losses/" + key);
+  for (size_t c = 0; c < columns.size(); ++c) header += (c ? "," : "") + columns[c];
   ProgressCut cut;
   if (options.resume && rank == 0) cut = cut_progress(csv_file, header, resumed.steps);
   if (!cut.kept_aside.empty())
@@ -421,7 +424,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
   if (!cut.append) csv << header << "\n";
   std::vector<std::vector<double>> rows = std::move(cut.rows);
-  for (auto& row : rows) row.resize(std::size(kColumns), std::nan(""));
+  for (auto& row : rows) row.resize(columns.size(), std::nan(""));
 
   const auto start = Clock::now();
   const long first_step = learner->steps();
@@ -464,6 +467,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                loss(s, "qf1_values"),
                                loss(s, "collect_seconds"),
                                loss(s, "update_seconds")};
+    for (const std::string& key : extra) row.push_back(loss(s, key.c_str()));
     for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << csv_cell(row[c]);
     csv << "\n";
     csv.flush();

@@ -110,6 +110,16 @@ TEST(EnvMatrix, SamiLearnersTrainOnSamiAndOnOtherFamilies) {
     EXPECT_EQ(r.steps, 400);
     EXPECT_TRUE(fs::exists(dir / "checkpoints" / "final.ckpt"));
     EXPECT_EQ(learn::read_checkpoint_info(dir / "checkpoints" / "final.ckpt").algorithm, algo);
+    // progress.csv: the common columns, then the learner's own (SaNCE's loss and weight), filled
+    // once updates run.
+    std::ifstream csv(dir / "logs" / "progress.csv");
+    std::string header, row, last;
+    std::getline(csv, header);
+    EXPECT_TRUE(header.ends_with(",perf/update_seconds,losses/sance_loss,losses/sance_weight"))
+        << header;
+    while (std::getline(csv, row)) last = row;
+    ASSERT_FALSE(last.empty());
+    EXPECT_NE(last.back(), ',') << last;  // the weight of the last report's updates
   }
   fs::remove_all(root);
 }
