@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -83,6 +84,24 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
                          (models / "model_2.ckpt").string());
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(lines(r.out), 1) << r.out;
+  // Training again under the same name is refused (the models stay) unless --overwrite.
+  const auto model = [&] {
+    std::ifstream in(models / "model_2.ckpt", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string before = model();
+  const std::string again =
+      "illustrate --env reach --algorithm PPO --train_for 32 --test_for 0 --save_every 32 "
+      "--save_model tiny --hp n_steps=32 --hp batch_size=32 --seed 9";
+  r = cradle_in(dir, again);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_EQ(lines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find("give --overwrite"), std::string::npos) << r.out;
+  EXPECT_EQ(model(), before);
+  r = cradle_in(dir, again + " --overwrite");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(models / "model_1.ckpt"));
+  EXPECT_FALSE(fs::exists(models / "model_2.ckpt"));  // the earlier run's models went
   fs::remove_all(dir);
 }
 
