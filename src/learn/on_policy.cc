@@ -107,6 +107,24 @@ struct JoinOnExit {
 
 }  // namespace
 
+TrainStats OnPolicyLearner::take_report(std::map<std::string, double>& sums, double updates,
+                                        double learning_rate, double& collect_seconds,
+                                        double& update_seconds, long start_steps,
+                                        double elapsed_seconds) {
+  TrainStats stats{.steps = steps_};
+  for (const auto& [name, value] : sums) stats.losses[name] = value / updates;
+  sums.clear();
+  stats.losses["learning_rate"] = learning_rate;
+  stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
+  stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
+  const EpisodeStats::Summary episodes = collector_.episodes().take();
+  stats.episodes = episodes.episodes;
+  stats.episodic_return = episodes.mean_return;
+  stats.episodic_length = episodes.mean_length;
+  stats.sps = static_cast<double>(steps_ - start_steps) / std::max(elapsed_seconds, 1e-9);
+  return stats;
+}
+
 void OnPolicyLearner::learn_overlapped(long total_steps, const ProgressFn& on_progress) {
   const Clock::time_point start = Clock::now();
   const long start_steps = steps_;
@@ -144,18 +162,10 @@ void OnPolicyLearner::learn_overlapped(long total_steps, const ProgressFn& on_pr
   // The report at the rollouts so far: the episodes they ended and the updates done since the
   // last report (none yet at the first). Returns on_progress's answer.
   const auto report = [&](double learning_rate) {
-    TrainStats stats{.steps = steps_};
-    for (const auto& [name, value] : sums) stats.losses[name] = value / std::max(updates, 1L);
-    sums.clear();
+    const TrainStats stats =
+        take_report(sums, static_cast<double>(std::max(updates, 1L)), learning_rate,
+                    collect_seconds, update_seconds, start_steps, seconds_since(start));
     updates = 0;
-    stats.losses["learning_rate"] = learning_rate;
-    stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
-    stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
-    const EpisodeStats::Summary episodes = collector_.episodes().take();
-    stats.episodes = episodes.episodes;
-    stats.episodic_return = episodes.mean_return;
-    stats.episodic_length = episodes.mean_length;
-    stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds_since(start), 1e-9);
     return !on_progress || on_progress(stats);
   };
 

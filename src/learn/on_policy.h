@@ -180,19 +180,10 @@ class OnPolicyLearner : public Learner {
 
       // Report: the mean of each loss over the updates since the last report.
       if (iteration % loop_.report_every != 0 && steps_ < total_steps) continue;
-      TrainStats stats{.steps = steps_};
       const double updates = static_cast<double>((iteration - 1) % loop_.report_every + 1);
-      for (const auto& [name, value] : sums) stats.losses[name] = value / updates;
-      sums.clear();
-      stats.losses["learning_rate"] = learning_rate;
-      stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
-      stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
-      const EpisodeStats::Summary episodes = collector_.episodes().take();
-      stats.episodes = episodes.episodes;
-      stats.episodic_return = episodes.mean_return;
-      stats.episodic_length = episodes.mean_length;
-      stats.sps =
-          static_cast<double>(steps_ - start_steps) / std::max(seconds(start, Clock::now()), 1e-9);
+      const TrainStats stats =
+          take_report(sums, updates, learning_rate, collect_seconds, update_seconds, start_steps,
+                      seconds(start, Clock::now()));
       if (on_progress && !on_progress(stats)) break;
     }
   }
@@ -326,6 +317,12 @@ class OnPolicyLearner : public Learner {
   void start_overlap(const VecEnv& env, const PolicyConfig& policy);
   // learn() with overlap_update (see the top).
   void learn_overlapped(long total_steps, const ProgressFn& on_progress);
+  // A report of both loops: the mean of each loss over `updates`, the learning rate, the seconds
+  // since the last report (zeroed), the episodes the collector ended since then, and the env
+  // steps per second since `start_steps` was the count; `sums` is emptied.
+  TrainStats take_report(std::map<std::string, double>& sums, double updates, double learning_rate,
+                         double& collect_seconds, double& update_seconds, long start_steps,
+                         double elapsed_seconds);
   // The learning rate of the iteration that starts at `steps`: constant, or annealed linearly.
   double learning_rate_at(long steps, long total_steps) const {
     if (!loop_.anneal_lr) return loop_.learning_rate;
