@@ -2,13 +2,17 @@
 // CLI runner (header-only; CRADLE_SOURCE_DIR and CRADLE_BINARY come from CMake).
 #pragma once
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/config.h"
@@ -87,6 +91,29 @@ inline RunResult run_cradle(const std::string& args, const std::filesystem::path
   std::string command = std::string(CRADLE_BINARY) + " " + args + " 2>&1";
   if (!dir.empty()) command = "cd '" + dir.string() + "' && " + command;
   return run(command);
+}
+
+// Starts `cradle <args>` (output discarded), polls `ready` every 5 ms for up to two minutes, then
+// kills it with SIGKILL (whether or not it became ready) and waits for it. Returns whether `ready`
+// held: kill -9 at a moment the caller chose, as a crash would.
+inline bool run_cradle_then_kill(const std::string& args, const std::function<bool()>& ready) {
+  const std::string cmd = "exec " + std::string(CRADLE_BINARY) + " " + args + " >/dev/null 2>&1";
+  const pid_t child = ::fork();
+  if (child < 0) return false;
+  if (child == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  bool seen = false;
+  while (!seen && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    seen = ready();
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return seen;
 }
 
 // Starts `cradle <args>`, sends it `signal` (e.g. "INT", "TERM") one second after `ready` exists

@@ -62,26 +62,13 @@ TEST_P(ResumeFamily, KillNineThenResumeEqualsUninterruptedRun) {
   const std::string tag = "resume_family_" + std::to_string(std::hash<std::string>{}(id) % 100000);
   const fs::path killed = cradle::test::fresh_dir(tag + "_killed");
   const fs::path whole = cradle::test::fresh_dir(tag + "_whole");
-  const std::string cmd = "exec " + std::string(CRADLE_BINARY) + " " + train_args(id, killed) +
-                          " --steps 1000000 >/dev/null 2>&1";
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   // Past the first checkpoint (256 steps) by at least one more rollout, then SIGKILL: whenever
   // that happens, the resumed run must end as the uninterrupted one.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  bool ready = false;
-  while (!ready && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    ready = fs::exists(killed / "checkpoints" / "latest.ckpt") &&
-            read_lines(killed / "logs" / "progress.csv").size() >= 4;
-  }
-  ::kill(child, SIGKILL);
-  int status = 0;
-  ::waitpid(child, &status, 0);
+  const bool ready =
+      cradle::test::run_cradle_then_kill(train_args(id, killed) + " --steps 1000000", [&] {
+        return fs::exists(killed / "checkpoints" / "latest.ckpt") &&
+               read_lines(killed / "logs" / "progress.csv").size() >= 4;
+      });
   ASSERT_TRUE(ready) << id << ": training never passed its first checkpoint";
 
   cradle::test::RunResult r = run_cradle(train_args(id, killed) + " --steps 1024 --resume");

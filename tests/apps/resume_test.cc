@@ -87,25 +87,12 @@ std::vector<std::string> progress_values(const fs::path& run) {
 TEST(Resume, KillNineThenResumeEqualsUninterruptedRun) {
   const fs::path killed = temp_dir("killed");
   const fs::path whole = temp_dir("whole");
-  const std::string cmd = "exec " + std::string(CRADLE_BINARY) + " " + train_args(killed) +
-                          " --steps 100000 >/dev/null 2>&1";
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
   // Past the first checkpoint (256) by at least one more rollout, then SIGKILL.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  bool ready = false;
-  while (!ready && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    ready = fs::exists(killed / "run" / "checkpoints" / "latest.ckpt") &&
-            read_lines(killed / "run" / "logs" / "progress.csv").size() >= 4;
-  }
-  ::kill(child, SIGKILL);
-  int status = 0;
-  ::waitpid(child, &status, 0);
+  const bool ready =
+      cradle::test::run_cradle_then_kill(train_args(killed) + " --steps 100000", [&] {
+        return fs::exists(killed / "run" / "checkpoints" / "latest.ckpt") &&
+               read_lines(killed / "run" / "logs" / "progress.csv").size() >= 4;
+      });
   ASSERT_TRUE(ready) << "training never passed its first checkpoint";
   const std::vector<nlohmann::json> before_kill = log_entries(killed / "run");
 
