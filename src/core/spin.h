@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <thread>
 
 namespace cradle {
 
@@ -17,13 +18,24 @@ inline void cpu_relax() {
 }
 
 // Polls `ready` for up to `budget`; true when it became true (the caller sleeps otherwise).
+// The first polls pause the core; later ones yield it (sched_yield), so that a thread which wants
+// the core meanwhile (an overlapped PPO update, another process) runs instead of this loop, while a
+// wake-up within the budget still needs no futex round trip. On 2 cores, pause-only polling took
+// the update's CPU: PPO self-touch with the overlapped update ran 3,259-3,479 env steps/s polling
+// 250 us with pauses, 3,626-3,697 with this loop and a 1 ms budget (docs/performance.md).
 template <class Ready>
 bool spin_until(Ready ready, std::chrono::microseconds budget) {
+  constexpr int kPauses = 64;  // about 3 us of pauses before the first yield
   const auto deadline = std::chrono::steady_clock::now() + budget;
   for (int k = 1;; ++k) {
     if (ready()) return true;
-    cpu_relax();
-    if (k % 64 == 0 && std::chrono::steady_clock::now() > deadline) return ready();
+    if (k <= kPauses) {
+      cpu_relax();
+      continue;
+    }
+    std::this_thread::yield();
+    // A yield can last a time slice when another thread runs: the clock is read after each one.
+    if (std::chrono::steady_clock::now() > deadline) return ready();
   }
 }
 

@@ -23,6 +23,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/spin.h"
 #include "envs/action_check.h"
 #include "learn/vector_env.h"
 
@@ -37,6 +38,13 @@ constexpr size_t kEnvSlotBytes = size_t{64} << 20;
 constexpr size_t kAlign = 64;
 
 size_t round_up(size_t n, size_t to) { return (n + to - 1) / to * to; }
+
+// Takes the semaphore if it is posted within a millisecond, polling (and yielding the core) the
+// while; false: the caller sleeps on it. A worker's next command and a step's end mostly come
+// that soon, and sem_post wakes no one in the kernel when nobody sleeps on the semaphore.
+bool take_soon(sem_t& semaphore) {
+  return spin_until([&] { return sem_trywait(&semaphore) == 0; }, std::chrono::microseconds{1000});
+}
 
 enum Command : std::int32_t { kBuild, kReset, kStep, kResetEnded, kOptions, kClose, kCall, kStop };
 enum Status : std::int32_t { kOk, kUserError, kInvalidArgument, kOtherError };
@@ -371,7 +379,9 @@ class WorkerLoop {
     sem_post(&c_.done);
     if (c_.status != kOk) _exit(1);
     for (;;) {
-      while (sem_wait(&c_.go) != 0) {
+      if (!take_soon(c_.go)) {
+        while (sem_wait(&c_.go) != 0) {
+        }
       }
       const int command = c_.command;
       guarded(c_, [&] { execute(command); });
@@ -676,7 +686,7 @@ void ProcVecEnv::throw_if_broken() const {
 
 void ProcVecEnv::wait(int w) {
   Control& c = shared_->control(w);
-  for (;;) {
+  for (bool taken = take_soon(c.done); !taken;) {
     // Wakes every 100 ms to see whether the worker is still there.
     timespec deadline{};
     clock_gettime(CLOCK_REALTIME, &deadline);
@@ -685,7 +695,8 @@ void ProcVecEnv::wait(int w) {
       deadline.tv_nsec -= 1'000'000'000;
       ++deadline.tv_sec;
     }
-    if (sem_timedwait(&c.done, &deadline) == 0) break;
+    if (sem_timedwait(&c.done, &deadline) == 0) taken = true;
+    if (taken) break;
     if (errno != ETIMEDOUT && errno != EINTR) {
       throw std::system_error(errno, std::generic_category(), "process vector: sem_timedwait");
     }
