@@ -85,12 +85,11 @@ class VectorEnv(_VectorBase):
             if training:
                 raise ValueError(f"training=True is for BabyBench (env '{spec.id}' writes no "
                                  "training log)")
-            if procs:
-                raise ValueError(f"procs is for BabyBench (env '{spec.id}' runs on threads)")
             self._config = None
             self._core = _cradle.VecEnv.for_id(spec.id, int(num_envs), int(threads), int(seed),
                                                autoreset_mode == "same_step",
-                                               registry.option_texts(env_options or {}))
+                                               registry.option_texts(env_options or {}),
+                                               int(procs))
         else:
             if env_options:
                 raise ValueError("env_options are for env ids of the mimo, tma and sami families "

@@ -1,9 +1,11 @@
-// `cradle soak --config FILE [--steps N] [--envs N] [--threads T | --procs P] [--eval-every N]
-// ...`: the long-running vision soak. Random actions drive a vector of envs on a thread pool (or
-// in worker processes) for N env steps; every --eval-every steps an evaluation env with its video
-// renderer is built, run and destroyed on the main thread while the vector's contexts live (the
-// train -> evaluation transition that crashed), and the run ends with an evaluation with video. It
-// prints progress, steps/s and the resident memory, and exits 0 only when everything finished.
+// `cradle soak --config FILE | --env ID [--steps N] [--envs N] [--threads T | --procs P]
+// [--eval-every N] ...`: the long-running vision soak. Random actions drive a vector of envs on a
+// thread pool (or in worker processes) for N env steps; every --eval-every steps an evaluation env
+// (with its video renderer, for a BabyBench config) is built, run and destroyed on the main thread
+// while the vector's contexts live (the train -> evaluation transition that crashed), and the run
+// ends with one more evaluation. It prints progress, steps/s and the resident memory (of each
+// worker process too), and exits 0 only when everything finished.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -17,15 +19,19 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/rng.h"
+#include "envs/registry.h"
+#include "learn/proc_vector_env.h"
 #include "train/babybench_vector.h"
+#include "train/env_vector.h"
+#include "train/episodes.h"
 #include "train/evaluation.h"
 
 namespace cradle::apps {
 namespace {
 
-// Resident and peak resident memory of this process, MB (/proc/self/status).
-std::pair<double, double> resident_mb() {
-  std::ifstream status("/proc/self/status");
+// Resident and peak resident memory of a process, MB (/proc/<pid>/status; 0 when it is gone).
+std::pair<double, double> resident_mb(const std::string& pid = "self") {
+  std::ifstream status("/proc/" + pid + "/status");
   std::string line;
   double rss = 0, peak = 0;
   while (std::getline(status, line)) {
@@ -40,6 +46,7 @@ std::pair<double, double> resident_mb() {
 void register_soak(CLI::App& app) {
   struct Options {
     std::string config;
+    std::string env;
     std::string save_dir;
     long steps = 500000;
     int envs = 2;
@@ -54,9 +61,15 @@ void register_soak(CLI::App& app) {
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "soak", "Vision soak: random actions on a vector of envs, evaluations with video between");
-  cmd->add_option("--config", opts->config, "BabyBench YAML config")->required();
+  CLI::Option* config_flag = cmd->add_option("--config", opts->config, "BabyBench YAML config");
+  CLI::Option* env_flag =
+      cmd->add_option("--env", opts->env,
+                      "An env id instead of a config (`cradle envs`), e.g. mimo/bench: its "
+                      "evaluations run random episodes without video");
+  config_flag->excludes(env_flag);
+  env_flag->excludes(config_flag);
   cmd->add_option("--out,--save-dir", opts->save_dir,
-                  "Output folder (default: the config's save_dir)");
+                  "Output folder (default: the config's save_dir; with --env, runs/soak)");
   cmd->add_option("--steps", opts->steps, "Env steps in total")
       ->check(CLI::Range(1L, 100000000000L));
   cmd->add_option("--envs", opts->envs, "Parallel envs")->check(CLI::Range(1, 1024));
@@ -78,12 +91,25 @@ void register_soak(CLI::App& app) {
   cmd->add_option("--seed", opts->seed, "Seed of the envs and the random actions")->check(kSeed);
   cmd->callback([opts] {
     using Clock = std::chrono::steady_clock;
-    Config config = load_config(opts->config);
+    if (opts->config.empty() == opts->env.empty())
+      throw UserError("soak: give a BabyBench config (--config FILE) or an env id (--env ID)");
+    const bool by_id = !opts->env.empty();
+    // An unknown id is refused before anything runs.
+    const std::string env_id = by_id ? envs::env_spec(opts->env).id : "";
+    if (by_id && envs::env_spec(env_id).family == "babybench")
+      throw UserError("soak: --env " + opts->env + " is a BabyBench config: give it as --config");
+    Config config = by_id ? default_config() : load_config(opts->config);
+    if (by_id) config.save_dir = "runs/soak";
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
+    if (opts->procs > 0 && opts->envs % opts->procs != 0) {
+      throw UserError("soak: --envs " + std::to_string(opts->envs) +
+                      " does not split evenly over --procs " + std::to_string(opts->procs) +
+                      "; give --envs a multiple of --procs");
+    }
     const std::filesystem::path dir = config.save_dir;
     int evaluations = 0;
     // An evaluation (own env, renderer and video) on this thread, in its own folder.
-    auto evaluate = [&](const char* when) {
+    auto evaluate_config = [&](const char* when) {
       Config ec = config;
       ec.save_dir = (dir / ("soak_eval_" + std::to_string(evaluations++))).string();
       const train::EvaluationOptions eo{.episodes = opts->eval_episodes,
@@ -98,12 +124,42 @@ void register_soak(CLI::App& app) {
                   std::chrono::duration<double>(Clock::now() - t).count());
       std::fflush(stdout);
     };
+    // An env id's evaluation: a fresh env of the id (its own renderers, if it has eyes) plays
+    // random episodes of at most --eval-duration steps.
+    auto evaluate_id = [&](const char* when) {
+      ++evaluations;
+      const Clock::time_point t = Clock::now();
+      std::unique_ptr<envs::Env> env = envs::make_env(env_id, opts->seed + 1000);
+      const Box& space = env->action_space();
+      Rng rng(opts->seed + 2000 + static_cast<std::uint64_t>(evaluations));
+      const train::EpisodePolicy random{
+          .act = [&](const envs::ObservationBuffers&, std::span<double> action) {
+            for (size_t j = 0; j < action.size(); ++j)
+              action[j] = rng.uniform(space.low[j], space.high[j]);
+          }};
+      std::vector<std::uint64_t> seeds;
+      for (int e = 0; e < opts->eval_episodes; ++e) seeds.push_back(opts->seed + 1000 + e);
+      const std::vector<train::EpisodeOutcome> episodes =
+          train::run_episodes(*env, random, seeds, opts->eval_duration);
+      double total = 0;
+      for (const train::EpisodeOutcome& e : episodes) total += e.episode_return;
+      std::printf("evaluation %d (%s): %zu episodes, mean return %.4f, %.1f s\n", evaluations, when,
+                  episodes.size(), total / static_cast<double>(episodes.size()),
+                  std::chrono::duration<double>(Clock::now() - t).count());
+      std::fflush(stdout);
+    };
+    auto evaluate = [&](const char* when) { by_id ? evaluate_id(when) : evaluate_config(when); };
 
     const Clock::time_point start = Clock::now();
     long steps = 0;
+    Clock::duration stepping{};  // inside the vector's step calls
     {
       std::unique_ptr<learn::VecEnv> vec;
-      if (opts->procs > 0) {
+      if (by_id) {
+        vec = train::make_env_training(env_id, opts->envs, opts->threads, opts->seed, nullptr, 0,
+                                       {}, opts->procs)
+                  .vec;
+      } else if (opts->procs > 0) {
         vec = train::make_babybench_proc_vec_env(config, opts->envs, opts->procs,
                                                  /*training=*/false, opts->seed);
       } else {
@@ -122,13 +178,24 @@ void register_soak(CLI::App& app) {
           const size_t j = k % space.size();
           actions[k] = rng.uniform(space.low[j], space.high[j]);
         }
+        const Clock::time_point before = Clock::now();
         vec->step(actions);
+        stepping += Clock::now() - before;
         steps += n;
         if (steps >= next_print) {
           const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
           const auto [rss, peak] = resident_mb();
-          std::printf("%ld steps, %.0f steps/s, RSS %.0f MB (peak %.0f MB)\n", steps,
-                      steps / seconds, rss, peak);
+          std::printf("%ld steps, %.0f steps/s, RSS %.0f MB (peak %.0f MB)", steps, steps / seconds,
+                      rss, peak);
+          if (const auto* procs = dynamic_cast<const learn::ProcVecEnv*>(vec.get())) {
+            std::printf(", workers");
+            for (const pid_t pid : procs->worker_pids()) {
+              const auto [worker_rss, worker_peak] = resident_mb(std::to_string(pid));
+              std::printf(" %.0f", worker_rss);
+            }
+            std::printf(" MB");
+          }
+          std::printf("\n");
           std::fflush(stdout);
           next_print += 10000;
         }
@@ -144,10 +211,12 @@ void register_soak(CLI::App& app) {
     evaluate("after the vector");
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
     std::printf(
-        "soak finished: %ld env steps on %d envs%s, %d evaluations, %.0f s, peak RSS %.0f MB\n",
+        "soak finished: %ld env steps on %d envs%s, %d evaluations, %.0f s, peak RSS %.0f MB; %.1f "
+        "env steps/s inside the vector's steps\n",
         steps, opts->envs,
         opts->procs > 0 ? (" in " + std::to_string(opts->procs) + " processes").c_str() : "",
-        evaluations, seconds, resident_mb().second);
+        evaluations, seconds, resident_mb().second,
+        steps / std::max(std::chrono::duration<double>(stepping).count(), 1e-9));
   });
 }
 

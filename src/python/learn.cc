@@ -16,6 +16,7 @@
 #include "envs/registry.h"
 #include "eval/log_check.h"
 #include "eval/scores.h"
+#include "learn/proc_vector_env.h"
 #include "learn/vector_env.h"
 #include "python/common.h"
 #include "python/python_teacher.h"
@@ -74,18 +75,25 @@ class PyVecEnv {
 
   // The envs of a registry id: env i made by the id's factory with index i and seed
   // ThreadedVecEnv::env_seed(seed, i), all sharing what the factory compiled once.
+  // procs > 0: in that many worker processes, as for a config.
   PyVecEnv(const std::string& id, int num_envs, int threads, std::uint64_t seed, bool same_step,
-           const envs::EnvOptions& options)
+           const envs::EnvOptions& options, int procs)
       : same_step_(same_step) {
     if (num_envs < 1) throw py::value_error("num_envs must be at least 1");
+    if (procs < 0) throw py::value_error("procs must be 0 (threads) or more");
     {
       py::gil_scoped_release release;
       const envs::EnvMaker maker = envs::env_maker(id, options);
-      auto vec = std::make_unique<learn::ThreadedVecEnv>(
-          num_envs, [&](int i) { return maker(i, learn::ThreadedVecEnv::env_seed(seed, i)); },
-          threads);
-      threaded_ = vec.get();
-      vec_ = std::move(vec);
+      const auto make = [&](int i) { return maker(i, learn::ThreadedVecEnv::env_seed(seed, i)); };
+      if (procs > 0) {
+        auto vec = std::make_unique<learn::ProcVecEnv>(num_envs, make, procs);
+        procs_ = vec.get();
+        vec_ = std::move(vec);
+      } else {
+        auto vec = std::make_unique<learn::ThreadedVecEnv>(num_envs, make, threads);
+        threaded_ = vec.get();
+        vec_ = std::move(vec);
+      }
     }
     entries_ = entries_of(vec_->observation_space());
   }
@@ -385,11 +393,13 @@ void bind_learn(py::module_& m) {
       .def_static(
           "for_id",
           [](const std::string& id, int num_envs, int threads, std::uint64_t seed, bool same_step,
-             const envs::EnvOptions& options) {
-            return std::make_unique<PyVecEnv>(id, num_envs, threads, seed, same_step, options);
+             const envs::EnvOptions& options, int procs) {
+            return std::make_unique<PyVecEnv>(id, num_envs, threads, seed, same_step, options,
+                                              procs);
           },
           py::arg("id"), py::arg("num_envs"), py::arg("threads") = 0, py::arg("seed") = 0,
           py::arg("same_step") = false, py::arg("options") = envs::EnvOptions{},
+          py::arg("procs") = 0,
           "The envs of a registry id (env i: index i, seed env_seed(seed, i)).")
       .def("set_reset_options", &PyVecEnv::set_reset_options, py::arg("options"))
       .def("reset", &PyVecEnv::reset, py::arg("seed"))

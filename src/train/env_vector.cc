@@ -3,11 +3,13 @@
 #include <memory>
 #include <vector>
 
+#include "learn/proc_vector_env.h"
+
 namespace cradle::train {
 
 TrainingVector make_env_training(const std::string& id, int num_envs, int threads,
                                  std::uint64_t seed, const EnvWrapper& wrap, int async_batch,
-                                 const envs::EnvOptions& options) {
+                                 const envs::EnvOptions& options, int procs) {
   using learn::ThreadedVecEnv;
   const envs::EnvMaker maker = envs::env_maker(id, options);
   TrainingVector out;
@@ -15,7 +17,11 @@ TrainingVector make_env_training(const std::string& id, int num_envs, int thread
     std::unique_ptr<envs::Env> env = maker(i, ThreadedVecEnv::env_seed(seed, i));
     return wrap ? wrap(std::move(env)) : std::move(env);
   };
-  if (async_batch > 0) {
+  if (procs > 0) {
+    // The factory runs in each worker after the fork: what the maker compiled here is shared
+    // copy-on-write.
+    out.vec = std::make_unique<learn::ProcVecEnv>(num_envs, make, procs);
+  } else if (async_batch > 0) {
     std::vector<std::unique_ptr<envs::Env>> list;
     for (int i = 0; i < num_envs; ++i) list.push_back(make(i));
     out.vec = std::make_unique<learn::AsyncVecEnv>(std::move(list), async_batch, threads);

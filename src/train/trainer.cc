@@ -172,7 +172,6 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                       " does not split evenly over --procs " + std::to_string(options.procs) +
                       "; give --envs a multiple of --procs");
     }
-    if (!options.env.empty()) throw UserError("--procs is for BabyBench configs, not --env");
     if (options.async_batch != 0) throw UserError("--procs and --async-batch: give one of them");
     if (!options.task_space.empty()) throw UserError("--procs is not available with --task-space");
   }
@@ -325,7 +324,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   TrainingVector training =
       by_id
           ? make_env_training(env_id, options.envs, options.threads, options.seed + rank, wrap,
-                              options.async_batch)
+                              options.async_batch, {}, options.procs)
           : make_babybench_training(env_config, options.envs, options.threads, options.seed + rank,
                                     kept_episodes, wrap, options.async_batch, options.procs);
   std::unique_ptr<VecEnv>& vec = training.vec;

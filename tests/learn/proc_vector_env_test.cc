@@ -10,6 +10,7 @@
 
 #include <cerrno>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "core/rng.h"
 #include "envs/babybench.h"
 #include "train/babybench_vector.h"
+#include "train/env_vector.h"
 
 namespace cradle::learn {
 namespace {
@@ -256,6 +258,37 @@ TEST(ProcVecEnv, CleanShutdownReapsEveryWorker) {
   }
   ASSERT_EQ(pids.size(), 3u);
   for (pid_t pid : pids) EXPECT_TRUE(gone(pid)) << pid;
+}
+
+// Any registered env id, of every family, runs in worker processes with the thread vector's
+// trajectories: the factory of the id is called in the workers, with the same indices and seeds.
+TEST(ProcVecEnv, EveryFamilyByIdHasTheThreadVectorsTrajectories) {
+  for (const char* id :
+       {"mimo/reach", "tma/stump-tracks:old_classic_bipedal", "sami/CrippleHalfCheetah:train"}) {
+    SCOPED_TRACE(id);
+    const std::unique_ptr<VecEnv> procs =
+        train::make_env_training(id, 4, 0, 11, nullptr, 0, {}, /*procs=*/2).vec;
+    const std::unique_ptr<VecEnv> threads = train::make_env_training(id, 4, 2, 11).vec;
+    ASSERT_NE(dynamic_cast<const ProcVecEnv*>(procs.get()), nullptr);
+    EXPECT_EQ(dynamic_cast<const ProcVecEnv&>(*procs).procs(), 2);
+    procs->reset(5);
+    threads->reset(5);
+    ASSERT_EQ(snapshot(*procs), snapshot(*threads));
+    Rng rng(3);
+    std::vector<double> actions(4 * procs->action_space().size());
+    int ended = 0;
+    for (int t = 0; t < 300; ++t) {
+      random_actions(procs->action_space(), rng, actions);
+      procs->step(actions);
+      threads->step(actions);
+      ASSERT_EQ(snapshot(*procs), snapshot(*threads)) << "step " << t;
+      for (int i = 0; i < 4; ++i) ended += procs->terminated()[i] || procs->truncated()[i];
+    }
+    // The walkers fall within 300 random steps: next-step autoreset is compared too.
+    if (std::string(id).starts_with("tma/")) {
+      EXPECT_GT(ended, 0);
+    }
+  }
 }
 
 // A process that has rendered cannot fork workers that render (Mesa's state does not survive a

@@ -165,6 +165,31 @@ def test_vector_matches_single_envs(env_id, steps):
         env.close()
 
 
+def test_vector_of_an_id_in_worker_processes_steps_as_threads():
+    import numpy as np
+    env_id = "tma/stump-tracks:old_classic_bipedal"
+    procs = cradle.VectorEnv(env_id, 4, seed=3, procs=2)
+    threads = cradle.VectorEnv(env_id, 4, seed=3, threads=2)
+    assert (procs.procs, threads.procs) == (2, 0)
+    obs_p, _ = procs.reset(seed=4)
+    obs_t, _ = threads.reset(seed=4)
+    rng = np.random.default_rng(0)
+    ended = 0
+    for _ in range(200):
+        for key in obs_t:
+            np.testing.assert_array_equal(obs_p[key], obs_t[key])
+        action = rng.uniform(-1, 1, size=procs.action_space.shape)
+        obs_p, rew_p, term_p, trunc_p, _ = procs.step(action)
+        obs_t, rew_t, term_t, trunc_t, _ = threads.step(action)
+        np.testing.assert_array_equal(rew_p, rew_t)
+        np.testing.assert_array_equal(term_p, term_t)
+        np.testing.assert_array_equal(trunc_p, trunc_t)
+        ended += int(np.sum(term_p | trunc_p))
+    assert ended > 0  # random walkers fall: the autoreset is compared too
+    procs.close()
+    threads.close()
+
+
 def test_vector_of_an_id_options_and_errors():
     vec = cradle.VectorEnv("tma/stump-tracks:old_classic_bipedal", 2, seed=1,
                            autoreset_mode="same_step", env_options={"motors_torque": 100})
@@ -174,8 +199,8 @@ def test_vector_of_an_id_options_and_errors():
         vec.reset(options={"stump_height": 99.0})  # outside the env's [-3, 9]
     with pytest.raises(ValueError, match="training"):
         cradle.VectorEnv("mimo/reach", 2, training=True)
-    with pytest.raises(ValueError, match="procs"):
-        cradle.VectorEnv("mimo/reach", 2, procs=1)
+    with pytest.raises(ValueError, match="do not split evenly over 2 processes"):
+        cradle.VectorEnv("mimo/reach", 3, procs=2)
     with pytest.raises(ValueError, match="closest"):
         cradle.VectorEnv("mimo/reech", 2)
     for threads in (-5, 1.5, True, "2"):
