@@ -38,7 +38,7 @@
 #include "envs/registry.h"
 #include "learn/intrinsic/reward.h"
 #include "learn/learner.h"
-#include "learn/meta/samplers.h"
+#include "learn/meta/methods.h"
 #include "learn/registry.h"
 #include "train/babybench_vector.h"
 

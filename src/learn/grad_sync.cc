@@ -2,6 +2,8 @@
 
 #include <ATen/CPUGeneratorImpl.h>
 
+#include "learn/grad_tensors.h"
+
 namespace cradle::learn {
 namespace {
 

@@ -1,6 +1,7 @@
 // What a learner needs from a data-parallel run, as a small interface so that learn/ does not
 // depend on how ranks talk (dist/ implements it over torch's c10d; train/dist_sync.h adapts it).
-// A learner given none (LearnerOptions::sync null) runs alone, unchanged.
+// A learner given none (LearnerOptions::sync null) runs alone, unchanged. No LibTorch here: the
+// tensor helpers are in learn/grad_tensors.h, so that the run and the CLI need not parse torch.h.
 //
 // The data-parallel contract every learner keeps: rank 0's initial parameters are broadcast, every
 // gradient is averaged over the ranks before clipping and the optimiser step, and every decision
@@ -8,11 +9,7 @@
 // is agreed on, so that every rank holds bitwise-identical parameters.
 #pragma once
 
-#include <torch/torch.h>
-
-#include <cstdint>
 #include <span>
-#include <vector>
 
 namespace cradle::learn {
 
@@ -33,19 +30,9 @@ class GradSync {
 inline bool distributed(const GradSync* sync) { return sync != nullptr && sync->world_size() > 1; }
 inline int world_size(const GradSync* sync) { return sync != nullptr ? sync->world_size() : 1; }
 
-// Averages a float32 contiguous tensor (a packed gradient) over the ranks, in place.
-void average_gradients(GradSync* sync, const torch::Tensor& gradient);
-// Every float32 parameter and buffer of `module` set to rank 0's.
-void broadcast_module(GradSync* sync, torch::nn::Module& module);
-void broadcast_tensor(GradSync* sync, const torch::Tensor& tensor);
 // The maximum of a value over the ranks (e.g. a count that decides how many collectives follow).
 double agree_max(GradSync* sync, double value);
 // The mean of a value over the ranks (e.g. PPO's approximate KL for its early stop).
 double agree_mean(GradSync* sync, double value);
-// A rank's own random stream after every rank restored the same generator (resume): rank r > 0
-// draws a new seed from it mixed with r, rank 0 keeps it, so the ranks explore differently.
-void offset_generator(GradSync* sync, at::Generator& generator);
-// FNV-1a over the bytes of tensors (parameters), to compare ranks and runs.
-std::uint64_t tensor_hash(const std::vector<torch::Tensor>& tensors);
 
 }  // namespace cradle::learn

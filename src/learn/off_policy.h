@@ -35,7 +35,7 @@
 #include <utility>
 #include <vector>
 
-#include "learn/grad_sync.h"
+#include "learn/grad_tensors.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/networks.h"

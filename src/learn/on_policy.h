@@ -51,7 +51,7 @@
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
-#include "learn/grad_sync.h"
+#include "learn/grad_tensors.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/networks.h"

@@ -20,7 +20,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "learn/checkpoint.h"
-#include "learn/grad_sync.h"
+#include "learn/grad_tensors.h"
 #include "learn/meta/context_sac.h"
 #include "learn/meta/samplers.h"
 #include "learn/meta/trajectory_replay.h"

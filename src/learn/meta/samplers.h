@@ -17,17 +17,10 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "learn/meta/methods.h"
 #include "learn/meta/trajectory_replay.h"
 
 namespace cradle::learn::meta {
-
-enum class Contrast { kNone, kEnvDiff, kOne, kHalf, kAll };
-
-// "TESAC", "CCM", "SaTESAC", "SaCCM", "SaCCMAll".
-std::span<const std::string_view> method_names();
-// The method's sampler; UserError naming the accepted methods for another name.
-Contrast method_contrast(std::string_view method);
-std::string_view contrast_name(Contrast contrast);  // none, env_diff, one, half, all
 
 struct ContrastSample {
   std::vector<long> positives, negatives;  // replay indices
