@@ -13,7 +13,7 @@
 
 #include "core/error.h"
 #include "dist/process_group.h"
-#include "learn/grad_sync.h"
+#include "learn/grad_tensors.h"
 #include "learn/networks.h"
 #include "train/dist_sync.h"
 

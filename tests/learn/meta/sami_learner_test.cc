@@ -18,7 +18,7 @@
 #include "envs/sami/sami_env.h"
 #include "envs/tma/tma_env.h"
 #include "learn/checkpoint.h"
-#include "learn/grad_sync.h"
+#include "learn/grad_tensors.h"
 #include "learn/hyperparams.h"
 #include "learn/meta/context_sac.h"
 #include "learn/networks.h"
