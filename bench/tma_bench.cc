@@ -3,6 +3,7 @@
 // bodies), the CPPN alone and a rendered frame.
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,7 +93,8 @@ BENCHMARK_CAPTURE(BM_ParkourStep, fish, "fish");
 void BM_Cppn(benchmark::State& state) {
   const Cppn cppn(data_dir() / "ground_ceiling_cppn.f32", 2);
   std::vector<float> out;
-  for (auto _ : state) cppn.generate({-0.15, 0.8, 0.1}, kTerrainLength, out);
+  const std::array<double, 3> input = {-0.15, 0.8, 0.1};
+  for (auto _ : state) cppn.generate(input, kTerrainLength, out);
 }
 BENCHMARK(BM_Cppn)->Unit(benchmark::kMicrosecond);
 
