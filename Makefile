@@ -51,7 +51,8 @@ run: build
 	  --intrinsic $(INTRINSIC) --steps $(STEPS) --envs $(ENVS) --eval-episodes $(EPISODES) \
 	  --compare-random
 
-# The tests (and only they) are built here: `make build` and `make run` compile no test target.
+# The tests are built here, and the benchmarks (each binary runs once as a test, so they cannot
+# rot unseen): `make build` and `make run` compile neither.
 test: build
 	@$(NICE) cmake --build $(BUILD_DIR) -j $(JOBS) --target cradle_tests
 	@cd $(BUILD_DIR) && $(NICE) ctest --output-on-failure -j $(JOBS)
