@@ -2,6 +2,7 @@
 
 import inspect
 import json
+import numbers
 import os
 import pickle
 
@@ -84,6 +85,7 @@ def train(
     task_space=None,
     teacher=None,
     overwrite=False,
+    procs=0,
 ):
     """Trains a policy with Cradle's C++ learners, exactly as `cradle train` does (same options,
     same outputs under save_dir: training log, logs/progress.csv, checkpoints/, plots/, the
@@ -115,6 +117,8 @@ def train(
     hyperparameters: {name: value} overrides of the algorithm's hyperparameters (as --hp).
     async_batch: K > 0 collects PPO/A2C rollouts asynchronously in batches of the first K of the
       envs to finish (as --async-batch; 1 <= K < envs); 0: lock-step.
+    procs: P > 0 runs the envs in P worker processes (as --procs; envs a multiple of P), each with
+      its own GL contexts, so envs that render draw in parallel; the same run as with threads.
 
     Returns a dict: run (the run folder), steps, seconds, steps_per_second, training_score,
     checkpoint, evaluation (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
@@ -128,6 +132,8 @@ def train(
     if intrinsic is None:
         intrinsic = ("body_part_novelty",) if config is not None else ()
     spec, terms = _split_intrinsic(intrinsic)
+    if not isinstance(procs, numbers.Integral) or isinstance(procs, bool) or procs < 0:
+        raise ValueError(f"procs must be a non-negative integer (0: threads), not {procs!r}")
     hp = {str(k): str(v) for k, v in (hyperparameters or {}).items()}
     base = load_config(config) if config is not None else _cradle.default_config()
     result = _cradle.train(
@@ -137,7 +143,7 @@ def train(
         bool(progress_bar), terms, env=env or "",
         save_dir=os.fspath(save_dir) if save_dir is not None else "",
         task_space=os.fspath(task_space) if task_space is not None else "",
-        teacher="" if teacher is None else teacher, overwrite=bool(overwrite),
+        teacher="" if teacher is None else teacher, overwrite=bool(overwrite), procs=int(procs),
     )
     for key in ("evaluation", "random_evaluation"):
         if result[key] is not None:

@@ -428,7 +428,7 @@ void bind_learn(py::module_& m) {
          const std::map<std::string, std::string>& hyperparameters, int eval_episodes,
          int eval_duration, bool eval_render, bool compare_random, bool progress_bar,
          const py::list& terms, const std::string& env, const std::string& save_dir,
-         const std::string& task_space, const py::object& teacher, bool overwrite) {
+         const std::string& task_space, const py::object& teacher, bool overwrite, int procs) {
         // An env id of any family: a BabyBench id trains its config, the others by id (their
         // run folder: save_dir, else results/<id>).
         Config run_config = config;
@@ -469,6 +469,7 @@ void bind_learn(py::module_& m) {
           o.teacher_factory = own_teacher->factory();
         }
         o.overwrite = overwrite;
+        o.procs = procs;
         std::vector<PyTerm> py_terms;
         for (const py::handle t : terms) {
           const py::tuple tt = py::reinterpret_borrow<py::tuple>(t);
@@ -504,7 +505,7 @@ void bind_learn(py::module_& m) {
       py::arg("hyperparameters"), py::arg("eval_episodes"), py::arg("eval_duration"),
       py::arg("eval_render"), py::arg("compare_random"), py::arg("progress_bar"), py::arg("terms"),
       py::arg("env") = "", py::arg("save_dir") = "", py::arg("task_space") = "",
-      py::arg("teacher") = "", py::arg("overwrite") = false,
+      py::arg("teacher") = "", py::arg("overwrite") = false, py::arg("procs") = 0,
       "Trains with the C++ learners (see cradle.train). Python reward terms are (fn, weight, "
       "full) tuples; teacher is a teacher's name or a Python teacher object.");
 

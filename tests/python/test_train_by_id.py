@@ -35,6 +35,25 @@ def test_train_by_id_on_every_family(tmp_path, env):
     assert json.loads((run / "run.json").read_text())["env"] == cradle.env_spec(env).id
 
 
+def test_worker_processes_train_the_run_of_threads(tmp_path):
+    runs = {}
+    for procs in (0, 2):
+        run = tmp_path / f"procs{procs}"
+        cradle.train(env="tma/stump-tracks:old_classic_bipedal", steps=1024, envs=2,
+                     hyperparameters=PPO, save_dir=run, progress_bar=False, eval_episodes=1,
+                     procs=procs)
+        runs[procs] = run
+    timing = {"time", "charts/SPS", "perf/collect_seconds", "perf/update_seconds"}
+    strip = lambda run: [{k: v for k, v in r.items() if k not in timing} for r in rows(run)]
+    assert strip(runs[2]) == strip(runs[0])
+    assert (runs[2] / "checkpoints" / "final.ckpt").read_bytes() == \
+        (runs[0] / "checkpoints" / "final.ckpt").read_bytes()
+    with pytest.raises(ValueError, match="procs must be a non-negative integer"):
+        cradle.train(env="mimo/reach", save_dir=tmp_path / "x", procs=-1)
+    with pytest.raises(ValueError, match="give --envs a multiple of --procs"):
+        cradle.train(env="mimo/reach", envs=3, save_dir=tmp_path / "y", procs=2)
+
+
 def test_a_teacher_drives_a_teachmyagent_run(tmp_path):
     space = tmp_path / "space.yml"
     space.write_text("teacher: Random\nparams:\n  stump_height: [0.5, 1.5]\n"
