@@ -27,6 +27,7 @@ import sys
 import tempfile
 
 TIMEOUT = 120
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the configs/ folder's parent
 
 
 def folder_digest(path):
@@ -380,6 +381,32 @@ def main():
         s.run(surface, "a finished run, no --resume", cmd + ["--out", run], "--overwrite",
               folder=run)
 
+    # --- Worker processes and the soak.
+    soak_out = ["--out", os.path.join(work, "soak"), "--steps", "10"]
+    for case, cmd, needle in [
+        ("soak without an env", ["soak"] + soak_out, "--config"),
+        ("soak --config and --env", ["soak", "--config", "configs/config_selftouch.yml",
+                                      "--env", "mimo/reach"] + soak_out, "--env"),
+        ("soak --env unknown", ["soak", "--env", "mimo/rech"] + soak_out, "mimo/rech"),
+        ("soak --env babybench id", ["soak", "--env", "babybench/selftouch"] + soak_out,
+         "--config"),
+        ("soak --procs uneven", ["soak", "--env", "mimo/reach", "--envs", "3", "--procs", "2"]
+         + soak_out, "--procs"),
+        ("soak --procs 0", ["soak", "--env", "mimo/reach", "--procs", "0"] + soak_out, "--procs"),
+        ("soak --out a file", ["soak", "--env", "mimo/reach", "--out", "/etc/hostname",
+                               "--steps", "10"], "/etc/hostname"),
+        ("train --env --procs uneven", tiny_train + ["--envs", "3", "--procs", "2", "--steps",
+                                                     "64", "--out", os.path.join(work, "p")],
+         "--procs"),
+        ("train --procs and --async-batch", tiny_train + ["--envs", "4", "--procs", "2",
+                                                          "--async-batch", "2", "--steps", "64",
+                                                          "--out", os.path.join(work, "p")],
+         "--async-batch"),
+    ]:
+        s.run("processes and soak", case, cmd, needle, cwd=ROOT)
+        shutil.rmtree(os.path.join(work, "soak"), ignore_errors=True)
+        shutil.rmtree(os.path.join(work, "p"), ignore_errors=True)
+
     # --- Python envs.
     py = [
         ("tma.make agent_body_type=None",
@@ -404,6 +431,10 @@ def main():
         ("VectorEnv threads=-5", "import cradle\ncradle.VectorEnv('mimo/reach', 2, threads=-5)"),
         ("make unknown id", "import cradle\ncradle.make('mimo/rech')"),
         ("train bad algo", "import cradle\ncradle.train(env='mimo/reach', algo='dqn', steps=10)"),
+        ("train procs=-1", "import cradle\ncradle.train(env='mimo/reach', steps=10, procs=-1)"),
+        ("train procs uneven",
+         "import cradle\ncradle.train(env='mimo/reach', steps=10, envs=3, procs=2)"),
+        ("VectorEnv id procs uneven", "import cradle\ncradle.VectorEnv('mimo/reach', 3, procs=2)"),
         ("render(-1, 10)",
          "import cradle\ne = cradle.make('mimo/reach', render_mode='rgb_array')\ne.reset()\n"
          "e.render(-1, 10)"),

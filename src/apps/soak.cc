@@ -107,6 +107,17 @@ void register_soak(CLI::App& app) {
                       "; give --envs a multiple of --procs");
     }
     const std::filesystem::path dir = config.save_dir;
+    {
+      std::error_code made;
+      std::filesystem::create_directories(dir, made);
+      if (made || !std::filesystem::is_directory(dir)) {
+        throw UserError("soak: cannot create the output folder '" + dir.string() +
+                        "': " + (made ? made.message() : "a file of that name is in the way"));
+      }
+    }
+    // The progress lines as a table, for the memory curve: soak.csv in the output folder.
+    std::ofstream table(dir / "soak.csv");
+    if (!table) throw UserError("soak: cannot write '" + (dir / "soak.csv").string() + "'");
     int evaluations = 0;
     // An evaluation (own env, renderer and video) on this thread, in its own folder.
     auto evaluate_config = [&](const char* when) {
@@ -167,6 +178,10 @@ void register_soak(CLI::App& app) {
                                             /*training=*/false, opts->seed);
       }
       const int n = vec->num_envs();
+      const auto* procs = dynamic_cast<const learn::ProcVecEnv*>(vec.get());
+      table << "steps,seconds,steps_per_s,rss_mb,peak_rss_mb";
+      for (int w = 0; procs && w < procs->procs(); ++w) table << ",worker_" << w << "_rss_mb";
+      table << "\n";
       const Box& space = vec->action_space();
       std::vector<double> actions(static_cast<size_t>(n) * space.size());
       Rng rng(opts->seed + 1);
@@ -187,15 +202,19 @@ void register_soak(CLI::App& app) {
           const auto [rss, peak] = resident_mb();
           std::printf("%ld steps, %.0f steps/s, RSS %.0f MB (peak %.0f MB)", steps, steps / seconds,
                       rss, peak);
-          if (const auto* procs = dynamic_cast<const learn::ProcVecEnv*>(vec.get())) {
+          table << steps << "," << seconds << "," << steps / seconds << "," << rss << "," << peak;
+          if (procs) {
             std::printf(", workers");
             for (const pid_t pid : procs->worker_pids()) {
-              const auto [worker_rss, worker_peak] = resident_mb(std::to_string(pid));
+              const double worker_rss = resident_mb(std::to_string(pid)).first;
               std::printf(" %.0f", worker_rss);
+              table << "," << worker_rss;
             }
             std::printf(" MB");
           }
           std::printf("\n");
+          table << "\n";
+          table.flush();
           std::fflush(stdout);
           next_print += 10000;
         }

@@ -5,6 +5,7 @@
 
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "fixture.h"
 
@@ -31,6 +32,12 @@ TEST(Soak, AnEnvIdInWorkerProcessesReportsEachWorkersMemory) {
   EXPECT_NE(r.out.find("soak finished: 10000 env steps on 2 envs in 2 processes, 2 evaluations, "),
             std::string::npos)
       << r.out;
+  // The same line in soak.csv, for the memory curve.
+  const std::vector<std::string> table = cradle::test::read_lines(dir / "soak.csv");
+  ASSERT_EQ(table.size(), 2u);
+  EXPECT_EQ(table[0],
+            "steps,seconds,steps_per_s,rss_mb,peak_rss_mb,worker_0_rss_mb,worker_1_rss_mb");
+  EXPECT_TRUE(std::regex_match(table[1], std::regex("10000(,[0-9.e+]+){6}"))) << table[1];
 }
 
 TEST(Soak, AWrongEnvChoiceIsOneLine) {
@@ -45,6 +52,12 @@ TEST(Soak, AWrongEnvChoiceIsOneLine) {
   EXPECT_EQ(config.out,
             "cradle: error: soak: --env babybench/selftouch is a BabyBench config: give it as "
             "--config\n");
+  const cradle::test::RunResult file =
+      run_cradle("soak --env mimo/reach --steps 10 --out /etc/hostname");
+  EXPECT_NE(file.status, 0);
+  EXPECT_EQ(file.out,
+            "cradle: error: soak: cannot create the output folder '/etc/hostname': Not a "
+            "directory\n");
   const cradle::test::RunResult uneven =
       run_cradle("soak --env mimo/reach --envs 3 --procs 2" + out);
   EXPECT_NE(uneven.status, 0);
