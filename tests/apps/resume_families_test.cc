@@ -3,16 +3,11 @@
 // rows and the final checkpoint byte for byte), for a MIMo sample task, a TeachMyAgent walker and
 // a SaMI robot.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "fixture.h"
