@@ -18,6 +18,7 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/rng.h"
 #include "envs/registry.h"
 #include "learn/proc_vector_env.h"
@@ -101,20 +102,9 @@ void register_soak(CLI::App& app) {
     Config config = by_id ? default_config() : load_config(opts->config);
     if (by_id) config.save_dir = "runs/soak";
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
-    if (opts->procs > 0 && opts->envs % opts->procs != 0) {
-      throw UserError("soak: --envs " + std::to_string(opts->envs) +
-                      " does not split evenly over --procs " + std::to_string(opts->procs) +
-                      "; give --envs a multiple of --procs");
-    }
+    if (opts->procs > 0) train::check_procs_split(opts->envs, opts->procs, "soak: ");
     const std::filesystem::path dir = config.save_dir;
-    {
-      std::error_code made;
-      std::filesystem::create_directories(dir, made);
-      if (made || !std::filesystem::is_directory(dir)) {
-        throw UserError("soak: cannot create the output folder '" + dir.string() +
-                        "': " + (made ? made.message() : "a file of that name is in the way"));
-      }
-    }
+    make_folder(dir, "soak: cannot create the output folder");
     // The progress lines as a table, for the memory curve: soak.csv in the output folder.
     std::ofstream table(dir / "soak.csv");
     if (!table) throw UserError("soak: cannot write '" + (dir / "soak.csv").string() + "'");

@@ -3,9 +3,17 @@
 #include <memory>
 #include <vector>
 
+#include "core/error.h"
 #include "learn/proc_vector_env.h"
 
 namespace cradle::train {
+
+void check_procs_split(int num_envs, int procs, const std::string& prefix) {
+  if (num_envs % procs == 0) return;
+  throw UserError(prefix + "--envs " + std::to_string(num_envs) +
+                  " does not split evenly over --procs " + std::to_string(procs) +
+                  "; give --envs a multiple of --procs");
+}
 
 TrainingVector make_env_training(const std::string& id, int num_envs, int threads,
                                  std::uint64_t seed, const EnvWrapper& wrap, int async_batch,

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/jsonl.h"
 #include "core/sealed_file.h"
 #include "envs/tma/tma_env.h"
@@ -268,16 +269,6 @@ fs::path resume_checkpoint(const fs::path& checkpoints, long env_steps) {
   return fs::exists(step) ? step : checkpoints / "latest.ckpt";
 }
 
-// Makes `folder` (and its parents): a one-line UserError naming it when that fails.
-void make_folder(const fs::path& folder) {
-  std::error_code ec;
-  fs::create_directories(folder, ec);
-  if (ec || !fs::is_directory(folder)) {
-    throw UserError("cannot create the run folder '" + folder.string() +
-                    "': " + (ec ? ec.message() : "a file of that name is in the way"));
-  }
-}
-
 // The files a run writes in its folder (removed by --overwrite).
 const char* const kRunFiles[] = {"run.json",     "progress.csv",  "test_returns.csv",
                                  "test_set.csv", "teacher.jsonl", "summary.json",
@@ -404,8 +395,8 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     check_teacher_book(dir / "teacher.jsonl", env.space.dims());
     for (const char* name : kLogs) cut_back(dir / name, state.sizes[name]);
   } else {
-    make_folder(dir);
-    make_folder(checkpoints);
+    make_folder(dir, "cannot create the run folder");
+    make_folder(checkpoints, "cannot create the run folder");
   }
   write_atomically(dir / "run.json", run_json.dump(2) + "\n");
 

@@ -167,11 +167,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // live apart from this process's.
   if (options.procs != 0) {
     if (options.procs < 1) throw UserError("--procs must be at least 1");
-    if (options.envs % options.procs != 0) {
-      throw UserError("--envs " + std::to_string(options.envs) +
-                      " does not split evenly over --procs " + std::to_string(options.procs) +
-                      "; give --envs a multiple of --procs");
-    }
+    check_procs_split(options.envs, options.procs);
     if (options.async_batch != 0) throw UserError("--procs and --async-batch: give one of them");
     if (!options.task_space.empty()) throw UserError("--procs is not available with --task-space");
   }

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/sealed_file.h"
 #include "eval/video.h"
 #include "learn/checkpoint.h"
@@ -182,11 +183,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
         }
       }
     }
-    std::filesystem::create_directories(run, ec);
-    if (ec || !std::filesystem::is_directory(run)) {
-      throw UserError("sami train: cannot create the run folder '" + run.string() +
-                      "': " + (ec ? ec.message() : "a file of that name is in the way"));
-    }
+    make_folder(run, "sami train: cannot create the run folder");
   }
   const std::filesystem::path checkpoint = run / "checkpoint.ckpt";
   const std::filesystem::path progress = run / "progress.csv";
