@@ -52,10 +52,10 @@ run: build
 	  --compare-random
 
 # The tests are built here, and the benchmarks (each binary runs once as a test, so they cannot
-# rot unseen): `make build` and `make run` compile neither.
+# rot unseen): `make build` and `make run` compile neither. In stages, each stage's tests running
+# as soon as its binaries are built (scripts/test-in-stages.sh): the first results come in seconds.
 test: build
-	@$(NICE) cmake --build $(BUILD_DIR) -j $(JOBS) --target cradle_tests
-	@cd $(BUILD_DIR) && $(NICE) ctest --output-on-failure -j $(JOBS)
+	@scripts/test-in-stages.sh $(BUILD_DIR) $(JOBS) $(NICE)
 
 # Google Benchmark targets (build/cradle_bench, build/teach_bench); `cradle bench` is the CLI's.
 bench: build
