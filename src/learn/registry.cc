@@ -10,13 +10,69 @@
 
 namespace cradle::learn {
 
+namespace {
+
+using Factory = std::unique_ptr<Learner> (*)(VecEnv&, const LearnerOptions&);
+
+struct Algorithm {
+  std::string_view name;
+  Factory make;
+  AlgorithmTraits traits;
+};
+
+// Every algorithm, in the order to list them; SaMI's methods follow (meta::sami_learner_names).
+constexpr Algorithm kAlgorithms[] = {
+    {"ppo", make_ppo, {.data_parallel = true, .async_collection = true}},
+    {"a2c", make_a2c, {.data_parallel = true, .async_collection = true}},
+    {"sac", make_sac, {.data_parallel = true}},
+    {"td3", make_td3, {}},
+    {"ddpg", make_ddpg, {}},
+};
+
+// "a, b, c <last> d".
+std::string join(const std::vector<std::string>& names, std::string_view last) {
+  std::string out;
+  for (size_t k = 0; k < names.size(); ++k) {
+    out += (k == 0                    ? ""
+            : k + 1 == names.size() ? " " + std::string(last) + " "
+                                    : ", ") +
+           names[k];
+  }
+  return out;
+}
+
+[[noreturn]] void unknown(std::string_view algorithm) {
+  throw UserError("unknown algorithm '" + std::string(algorithm) + "' (expected " +
+                  join(algorithm_names(), "or") + ")");
+}
+
+}  // namespace
+
 const std::vector<std::string>& algorithm_names() {
   static const std::vector<std::string> names = [] {
-    std::vector<std::string> out{"ppo", "a2c", "sac", "td3", "ddpg"};
+    std::vector<std::string> out;
+    for (const Algorithm& a : kAlgorithms) out.emplace_back(a.name);
     for (const std::string_view name : meta::sami_learner_names()) out.emplace_back(name);
     return out;
   }();
   return names;
+}
+
+AlgorithmTraits algorithm_traits(std::string_view algorithm) {
+  for (const Algorithm& a : kAlgorithms) {
+    if (a.name == algorithm) return a.traits;
+  }
+  // SaMI's learners train alone (make_sami_learner refuses a sync) and collect lock-step.
+  if (!meta::sami_method(algorithm).empty()) return {};
+  unknown(algorithm);
+}
+
+std::string algorithms_with(bool AlgorithmTraits::*trait, std::string_view last) {
+  std::vector<std::string> names;
+  for (const std::string& name : algorithm_names()) {
+    if (algorithm_traits(name).*trait) names.push_back(name);
+  }
+  return join(names, last);
 }
 
 std::vector<std::string> extra_report_keys(std::string_view algorithm) {
@@ -26,21 +82,13 @@ std::vector<std::string> extra_report_keys(std::string_view algorithm) {
 
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options) {
-  if (algorithm == "ppo") return make_ppo(env, options);
-  if (algorithm == "a2c") return make_a2c(env, options);
-  if (algorithm == "sac") return make_sac(env, options);
-  if (algorithm == "td3") return make_td3(env, options);
-  if (algorithm == "ddpg") return make_ddpg(env, options);
+  for (const Algorithm& a : kAlgorithms) {
+    if (a.name == algorithm) return a.make(env, options);
+  }
   if (!meta::sami_method(algorithm).empty()) {
     return meta::make_sami_learner(algorithm, env, options);
   }
-  // "ppo, a2c, ... or saccm_all".
-  const std::vector<std::string>& names = algorithm_names();
-  std::string expected;
-  for (size_t k = 0; k < names.size(); ++k) {
-    expected += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
-  }
-  throw UserError("unknown algorithm '" + std::string(algorithm) + "' (expected " + expected + ")");
+  unknown(algorithm);
 }
 
 }  // namespace cradle::learn

@@ -21,6 +21,17 @@ const std::vector<std::string>& algorithm_names();
 std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
                                       const LearnerOptions& options);
 
+// What an algorithm can do besides training on one process's vector of envs.
+struct AlgorithmTraits {
+  bool data_parallel = false;     // --distributed: gradients averaged over ranks (LearnerOptions::sync)
+  bool async_collection = false;  // --async-batch: collects from an AsyncVecEnv in batches
+};
+// UserError naming the algorithms for an unknown name.
+AlgorithmTraits algorithm_traits(std::string_view algorithm);
+// The algorithms that have `trait`, in listing order, for messages: "ppo, a2c or sac" (`last` is
+// the word before the last name).
+std::string algorithms_with(bool AlgorithmTraits::*trait, std::string_view last = "or");
+
 // The report keys (TrainStats::losses) an algorithm adds to those every run logs, in order: a
 // run's progress.csv gives each a losses/<key> column (SaMI's methods: "sance_loss",
 // "sance_weight"; the others none).

@@ -218,8 +218,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // own (continued as they are on resume: the checkpoint counts rank 0's episodes).
   GradSync* sync = distributed(options.sync.get()) ? options.sync.get() : nullptr;
   const int rank = sync ? sync->rank() : 0;
-  if (sync && algorithm != "ppo" && algorithm != "a2c" && algorithm != "sac") {
-    throw UserError("--distributed trains ppo, a2c or sac, not " + algorithm);
+  if (sync && !learn::algorithm_traits(algorithm).data_parallel) {
+    throw UserError("--distributed trains " +
+                    learn::algorithms_with(&learn::AlgorithmTraits::data_parallel) + ", not " +
+                    algorithm);
   }
   // Async collection is the on-policy collector's (docs/async.md).
   if (options.async_batch != 0) {
@@ -228,9 +230,10 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                       " must be between 1 and --envs - 1 (" + std::to_string(options.envs - 1) +
                       "): a batch is part of the envs");
     }
-    if (algorithm != "ppo" && algorithm != "a2c") {
-      throw UserError("--async-batch is for ppo and a2c (their rollout collector), not " +
-                      algorithm);
+    if (!learn::algorithm_traits(algorithm).async_collection) {
+      throw UserError("--async-batch is for " +
+                      learn::algorithms_with(&learn::AlgorithmTraits::async_collection, "and") +
+                      " (their rollout collector), not " + algorithm);
     }
     if (sync) throw UserError("--async-batch is not available with --distributed");
   }

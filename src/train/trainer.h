@@ -73,7 +73,8 @@ struct TrainOptions {
   const std::atomic<bool>* stop = nullptr;
   // A data-parallel run's ranks (docs/distributed.md); null or one rank: this process alone. Rank
   // r seeds with seed + r; rank 0 writes progress.csv, checkpoints, plots and the evaluation;
-  // rank r > 0 logs its envs under <save_dir>/ranks/<r>/. PPO, A2C and SAC only.
+  // rank r > 0 logs its envs under <save_dir>/ranks/<r>/. The algorithms whose
+  // learn::algorithm_traits say data_parallel.
   std::shared_ptr<learn::GradSync> sync;
 };
 

@@ -83,6 +83,23 @@ TEST(SamiLearner, RegistryListsAndBuildsEveryAlgorithm) {
       << error;
 }
 
+// The run asks the registry which algorithms train data-parallel or collect asynchronously;
+// SaMI's context learners do neither.
+TEST(SamiLearner, RegistryTellsWhatEachAlgorithmCanDo) {
+  EXPECT_EQ(algorithms_with(&AlgorithmTraits::data_parallel), "ppo, a2c or sac");
+  EXPECT_EQ(algorithms_with(&AlgorithmTraits::async_collection, "and"), "ppo and a2c");
+  EXPECT_TRUE(algorithm_traits("sac").data_parallel);
+  EXPECT_FALSE(algorithm_traits("sac").async_collection);
+  EXPECT_FALSE(algorithm_traits("td3").data_parallel);
+  for (const std::string_view name : sami_learner_names()) {
+    EXPECT_FALSE(algorithm_traits(name).data_parallel) << name;
+    EXPECT_FALSE(algorithm_traits(name).async_collection) << name;
+  }
+  const std::string error = user_error([] { algorithm_traits("dqn"); });
+  EXPECT_TRUE(one_line(error));
+  EXPECT_NE(error.find("unknown algorithm 'dqn'"), std::string::npos) << error;
+}
+
 TEST(SamiLearner, SaccmTrainsOnSamiEnvsAndReportsFiniteLosses) {
   auto vec = sami_envs(2, 3);
   auto learner = make_learner("saccm", *vec, {.seed = 3, .hyperparameters = tiny_hp()});
