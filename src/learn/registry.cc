@@ -33,10 +33,7 @@ constexpr Algorithm kAlgorithms[] = {
 std::string join(const std::vector<std::string>& names, std::string_view last) {
   std::string out;
   for (size_t k = 0; k < names.size(); ++k) {
-    out += (k == 0                    ? ""
-            : k + 1 == names.size() ? " " + std::string(last) + " "
-                                    : ", ") +
-           names[k];
+    out += (k == 0 ? "" : k + 1 == names.size() ? " " + std::string(last) + " " : ", ") + names[k];
   }
   return out;
 }
