@@ -270,10 +270,7 @@ TrainStats OffPolicyLearner::report(Clock::time_point start, long start_steps,
   stats.losses["updates"] = static_cast<double>(updates_);  // gradient steps so far
   stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
   stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
-  const EpisodeStats::Summary episodes = collector_.episodes().take();
-  stats.episodes = episodes.episodes;
-  stats.episodic_return = episodes.mean_return;
-  stats.episodic_length = episodes.mean_length;
+  collector_.episodes().report_into(stats);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
   return stats;

@@ -117,10 +117,7 @@ TrainStats OnPolicyLearner::take_report(std::map<std::string, double>& sums, dou
   stats.losses["learning_rate"] = learning_rate;
   stats.losses["collect_seconds"] = std::exchange(collect_seconds, 0.0);
   stats.losses["update_seconds"] = std::exchange(update_seconds, 0.0);
-  const EpisodeStats::Summary episodes = collector_.episodes().take();
-  stats.episodes = episodes.episodes;
-  stats.episodic_return = episodes.mean_return;
-  stats.episodic_length = episodes.mean_length;
+  collector_.episodes().report_into(stats);
   stats.sps = static_cast<double>(steps_ - start_steps) / std::max(elapsed_seconds, 1e-9);
   return stats;
 }

@@ -85,15 +85,13 @@ void EpisodeStats::end(int env) {
   lengths_[env] = 0;
 }
 
-EpisodeStats::Summary EpisodeStats::take() {
-  Summary summary{.episodes = ended_};
-  summary.mean_return =
-      ended_ > 0 ? sum_return_ / ended_ : std::numeric_limits<double>::quiet_NaN();
-  summary.mean_length =
-      ended_ > 0 ? sum_length_ / ended_ : std::numeric_limits<double>::quiet_NaN();
+void EpisodeStats::report_into(TrainStats& stats) {
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  stats.episodes = ended_;
+  stats.episodic_return = ended_ > 0 ? sum_return_ / ended_ : none;
+  stats.episodic_length = ended_ > 0 ? sum_length_ / ended_ : none;
   sum_return_ = sum_length_ = 0;
   ended_ = 0;
-  return summary;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -63,11 +63,9 @@ class EpisodeStats {
   void reset(int envs);
   void add(int env, double reward);  // one step of env's current episode
   void end(int env);                 // env's episode ended
-  struct Summary {
-    int episodes = 0;
-    double mean_return = 0, mean_length = 0;  // NaN when no episode ended
-  };
-  Summary take();  // episodes ended since the last take
+  // The episodes ended since the last report into a learner's report (their count, mean return
+  // and length; NaN when none ended), then forgotten.
+  void report_into(TrainStats& stats);
 
  private:
   std::vector<double> returns_;

@@ -401,10 +401,7 @@ TrainStats SamiLearner::report(Clock::time_point start, long start_steps) {
   long trajectories = 0;
   for (int i = 0; i < envs_; ++i) trajectories += replay_.stored(i);
   stats.losses["buffer_trajectories"] = static_cast<double>(trajectories);
-  const EpisodeStats::Summary episodes = stepper_.episodes().take();
-  stats.episodes = episodes.episodes;
-  stats.episodic_return = episodes.mean_return;
-  stats.episodic_length = episodes.mean_length;
+  stepper_.episodes().report_into(stats);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   stats.sps = static_cast<double>(steps_ - start_steps) / std::max(seconds, 1e-9);
   return stats;
