@@ -20,6 +20,7 @@
 #include "envs/babybench.h"
 #include "train/babybench_vector.h"
 #include "train/env_vector.h"
+#include "vector_snapshot.h"
 
 namespace cradle::learn {
 namespace {
@@ -32,43 +33,8 @@ Config config_of(const char* file, int max_steps) {
   return config;
 }
 
-void random_actions(const Box& space, Rng& rng, std::vector<double>& actions) {
-  const size_t dim = space.low.size();
-  for (size_t j = 0; j < actions.size(); ++j) {
-    actions[j] = rng.uniform(space.low[j % dim], space.high[j % dim]);
-  }
-}
-
-// Everything a call produces, for every env, as bytes: rewards, flags, observations, scores and
-// every info value (unpublished ones included).
-std::vector<std::byte> snapshot(const VecEnv& vec) {
-  std::vector<std::byte> out;
-  auto append = [&](const auto& values) {
-    const auto bytes = std::as_bytes(std::span(values));
-    out.insert(out.end(), bytes.begin(), bytes.end());
-  };
-  append(vec.rewards());
-  append(vec.terminated());
-  append(vec.truncated());
-  for (int i = 0; i < vec.num_envs(); ++i) {
-    for (int k = 0; k < vec.observation(i).count(); ++k) append(vec.observation(i).bytes(k));
-    const double score = vec.env(i).score();
-    append(std::span(&score, 1));
-    const envs::Info& info = vec.info(i);
-    append(std::span(&info.steps, 1));
-    for (int k = 0; k < info.size(); ++k) {
-      if (info.type(k) == envs::InfoType::kIntList) {
-        append(info.list(k));
-        const int end = -1;  // lists of different splits differ
-        append(std::span(&end, 1));
-      } else {
-        const double number = info.number(k);
-        append(std::span(&number, 1));
-      }
-    }
-  }
-  return out;
-}
+using test::random_actions;
+using test::snapshot;
 
 bool gone(pid_t pid) { return kill(pid, 0) != 0 && errno == ESRCH; }
 

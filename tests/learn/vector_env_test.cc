@@ -17,6 +17,7 @@
 #include "core/rng.h"
 #include "envs/babybench.h"
 #include "train/babybench_vector.h"
+#include "vector_snapshot.h"
 
 namespace cradle::learn {
 namespace {
@@ -47,13 +48,8 @@ bool same_observation(const envs::ObservationBuffers& a, const envs::Observation
   return true;
 }
 
-// Uniform random actions for every env, from `rng`.
-void random_actions(const Box& space, Rng& rng, std::vector<double>& actions) {
-  const size_t dim = space.low.size();
-  for (size_t j = 0; j < actions.size(); ++j) {
-    actions[j] = rng.uniform(space.low[j % dim], space.high[j % dim]);
-  }
-}
+using test::random_actions;
+using test::snapshot;
 
 TEST(ThreadedVecEnv, SpacesAreOneEnvs) {
   const auto assets = envs::make_assets(self_touch(20));
@@ -165,22 +161,6 @@ TEST(ThreadedVecEnv, ResetEndedResetsInTheSameStep) {
     EXPECT_EQ(static_cast<envs::BabyBenchEnv&>(vec->env(i)).episode_steps(), 1);
     EXPECT_EQ(vec->truncated()[i], 0);
   }
-}
-
-// Everything a step produces, for every env, as bytes.
-std::vector<std::byte> snapshot(const ThreadedVecEnv& vec) {
-  std::vector<std::byte> out;
-  auto append = [&](const auto& values) {
-    const auto bytes = std::as_bytes(std::span(values));
-    out.insert(out.end(), bytes.begin(), bytes.end());
-  };
-  append(vec.rewards());
-  append(vec.terminated());
-  append(vec.truncated());
-  for (int i = 0; i < vec.num_envs(); ++i) {
-    for (int k = 0; k < vec.observation(i).count(); ++k) append(vec.observation(i).bytes(k));
-  }
-  return out;
 }
 
 TEST(ThreadedVecEnv, SameBatchesForAnyThreadCount) {
