@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "campaign_lines.h"
 #include "envs/registry.h"
 #include "fixture.h"
 #include "learn/intrinsic/reward.h"
@@ -25,21 +26,8 @@ namespace fs = std::filesystem;
 using cradle::test::run_cradle;
 using cradle::test::RunResult;
 
-// The configuration lines of a campaign file or a command's output (no comments, no "wrote").
-std::vector<std::string> config_lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) {
-    if (!l.empty() && l[0] != '#' && l.rfind("wrote", 0) != 0) lines.push_back(l);
-  }
-  return lines;
-}
-
-int count(const std::vector<std::string>& lines, const std::string& needle) {
-  int n = 0;
-  for (const std::string& l : lines) n += l.find(needle) != std::string::npos;
-  return n;
-}
+using cradle::test::config_lines;
+using cradle::test::count;
 
 std::string read(const fs::path& file) {
   std::ifstream in(file);

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "campaign_lines.h"
 #include "envs/tma/tma_env.h"
 #include "fixture.h"
 #include "learn/registry.h"
@@ -31,20 +32,8 @@ using cradle::test::RunResult;
 // A shell command, stdout and stderr together.
 RunResult shell(const std::string& cmd) { return cradle::test::run(cmd + " 2>&1"); }
 
-std::vector<std::string> config_lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) {
-    if (!l.empty() && l[0] != '#' && l.rfind("wrote", 0) != 0) lines.push_back(l);
-  }
-  return lines;
-}
-
-int count(const std::vector<std::string>& lines, const std::string& needle) {
-  int n = 0;
-  for (const std::string& l : lines) n += l.find(needle) != std::string::npos;
-  return n;
-}
+using cradle::test::config_lines;
+using cradle::test::count;
 
 fs::path fresh(const std::string& tag) {
   const fs::path d =
