@@ -1,7 +1,8 @@
 // The methods of SaMI's table (tma_sami.md §6) and their contrastive samplers. Each method's
 // distinctive part is how it picks positive and negative trajectories for the SaNCE/InfoNCE loss;
-// each sampler lives in the file of its method:
-//   TESAC     (tesac.cc)      none: the encoder learns through the critic only
+// each sampler lives in the file of its method (TESAC has none, so no file: method_contrast is
+// kNone and ContextSac::update skips the SaNCE step):
+//   TESAC                     none: the encoder learns through the critic's gradient only
 //   CCM       (ccm.cc)        env_diff: positives from one training env, negatives from another
 //   SaTESAC   (satesac.cc)    one: one env's batch sorted by average return, top / bottom
 //   SaCCM     (saccm.cc)      half: negatives the low-return half of a batch over all envs,
