@@ -23,6 +23,7 @@
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/jsonl.h"
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
@@ -212,10 +213,8 @@ void run(const IllustrateOptions& o) {
             name == "figures.json")
           fs::remove(entry.path(), ec);
       }
-      ec.clear();
     }
-    fs::create_directories(dir, ec);
-    if (ec) throw UserError("cannot create '" + dir.string() + "': " + ec.message());
+    make_folder(dir, "cannot create");
     std::ofstream csv(dir / "progress.csv");
     if (!csv) throw UserError("cannot write '" + (dir / "progress.csv").string() + "'");
     csv << "global_step,time,charts/SPS,charts/episodic_return,charts/episodic_length,"

@@ -21,6 +21,7 @@
 #include "apps/commands.h"
 #include "apps/interrupt.h"
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/image.h"
 #include "core/rng.h"
 #include "eval/video.h"
@@ -84,8 +85,7 @@ void build_scene(const std::string& name, const std::string& split, int task, st
   auto env = sami::make_env(id, {std::move(sets[task])}, seed);
   env->reset(seed);
   const std::string xml = sami::scene_xml(*env);
-  fs::create_directories(dir, ec);
-  if (ec) throw UserError("cannot create folder '" + out + "': " + ec.message());
+  make_folder(dir, "cannot create folder");
   const fs::path file = dir / "scene.xml";
   {
     std::ofstream stream(file, std::ios::binary);

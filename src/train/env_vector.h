@@ -10,15 +10,15 @@
 
 namespace cradle::train {
 
+// A UserError "<prefix>--envs N does not split evenly over --procs P; ..." unless P divides N.
+void check_procs_split(int num_envs, int procs, const std::string& prefix = "");
+
 // `num_envs` envs of `id` from one factory (what they share compiled once), env i made with
 // index i and seed ThreadedVecEnv::env_seed(seed, i) and wrapped by `wrap` when given. No training
 // log (log null, end_episodes does nothing). async_batch > 0: an AsyncVecEnv returning batches of
 // that many envs; procs > 0: a ProcVecEnv, the envs made and stepped in that many worker
 // processes (each its own GL context: envs that render draw in parallel), the same trajectories.
 // UserError for an unknown id or option.
-// A UserError "<prefix>--envs N does not split evenly over --procs P; ..." unless P divides N.
-void check_procs_split(int num_envs, int procs, const std::string& prefix = "");
-
 TrainingVector make_env_training(const std::string& id, int num_envs, int threads,
                                  std::uint64_t seed, const EnvWrapper& wrap = nullptr,
                                  int async_batch = 0, const envs::EnvOptions& options = {},

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/folders.h"
 #include "core/jsonl.h"
 #include "core/sealed_file.h"
 #include "envs/babybench.h"
@@ -315,9 +316,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   // A resumed run's first resets end no episode of this run's log.
   if (by_id) {
     for (const fs::path& logs : {dir / "logs", fs::path(env_config.save_dir) / "logs"}) {
-      std::error_code made;
-      fs::create_directories(logs, made);
-      if (made) throw UserError("cannot create '" + logs.string() + "': " + made.message());
+      make_folder(logs, "cannot create");
     }
   }
   TrainingVector training =
