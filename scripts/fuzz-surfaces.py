@@ -355,12 +355,13 @@ def main():
                    check=True, capture_output=True)
     s.run("SaMI CLI", "sami evaluate --split sideways",
           ["sami", "evaluate", "--run", sami_run, "--split", "sideways"], "sideways")
-    sami_keys = ["env", "method", "seed", "steps_per_env", "hyperparameters"]
-    damaged_runs(s, "run files: sami train", sami_run, [("run.json", sami_keys), "checkpoint.ckpt"],
+    sami_keys = ["env", "family", "algorithm", "seed", "steps", "envs", "hyperparameters"]
+    damaged_runs(s, "run files: sami train", sami_run,
+                 [("run.json", sami_keys), "checkpoints/latest.ckpt", "logs/progress.csv"],
                  lambda run: ["sami", "train", "--out", run, "--resume", "--steps", "600",
                               "--no-progress"], args.quick)
     damaged_runs(s, "run files: sami evaluate", sami_run,
-                 [("run.json", sami_keys), "checkpoint.ckpt"],
+                 [("run.json", sami_keys), "checkpoints/latest.ckpt"],
                  lambda run: ["sami", "evaluate", "--run", run, "--episodes", "1"], args.quick)
     train_run = os.path.join(work, "train_base")
     subprocess.run([cradle] + tiny_train + ["--steps", "256", "--out", train_run], check=True,

@@ -189,8 +189,9 @@ def train(env=None, method=None, seed=0, steps_per_env=0, hyperparameters=None,
     env and method default to PandaPush and SaCCM; resume=True with out continues that run's env
     and method (an env or method given must be the run's, else ValueError). steps_per_env=0 takes
     SaMI's budget (500k per env; PandaPush 1M). hyperparameters: a dict of overrides
-    ({"batch_size": 32}). Returns a dict: run, steps, updates, sps, gradient_steps_per_s,
-    last_return, checkpoint. Bad inputs raise ValueError (one line).
+    ({"batch_size": 32}). The run folder is `cradle train --env`'s (run.json, logs/progress.csv,
+    checkpoints/). Returns a dict: run, steps, updates, sps, gradient_steps_per_s, last_return,
+    checkpoint (checkpoints/final.ckpt). Bad inputs raise ValueError (one line).
     """
     continues = bool(resume) and bool(str(out))
     env = ("" if continues else "PandaPush") if env is None else env

@@ -5,9 +5,9 @@
 // or a local process pool; the analysis of each kind's results tree is campaign_analyze.cc.
 //
 // A seed is finished when its folder holds `finished` (written by the launcher after exit status
-// 0) or what its command leaves when done: done.json (`tma run`); the whole step budget in
-// progress.csv and every asked evaluation (`sami train`); checkpoints/final.ckpt at the asked
-// steps, with evaluation.json when the run evaluates (`train`).
+// 0) or what its command leaves when done: done.json (`tma run`); checkpoints/final.ckpt at the
+// run's whole budget and every asked evaluation (`sami train`); checkpoints/final.ckpt at the
+// asked steps, with evaluation.json when the run evaluates (`train`).
 #include "apps/campaign.h"
 
 #include <fcntl.h>
@@ -36,11 +36,13 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "envs/registry.h"
+#include "learn/checkpoint.h"
 #include "learn/intrinsic/reward.h"
 #include "learn/learner.h"
 #include "learn/meta/methods.h"
 #include "learn/registry.h"
 #include "train/babybench_vector.h"
+#include "train/sami/sami_train.h"
 
 extern char** environ;
 
@@ -394,19 +396,6 @@ struct SeedRun {
   fs::path dir;
 };
 
-// The last row's first cell of a CSV file (-1 when it has no row).
-long last_row_steps(const fs::path& file) {
-  std::ifstream in(file);
-  std::string row, last;
-  for (bool header = true; std::getline(in, row); header = false) {
-    if (!header && !row.empty()) last = row;
-  }
-  if (last.empty()) return -1;
-  char* end = nullptr;
-  const long v = std::strtol(last.c_str(), &end, 10);
-  return end == last.c_str() ? -1 : v;
-}
-
 // What the kind's command leaves in its folder when it is done.
 std::string done_by_files(const SeedRun& r) {
   std::error_code ec;
@@ -414,20 +403,20 @@ std::string done_by_files(const SeedRun& r) {
     case RunKind::kTma:
       return fs::exists(r.dir / "done.json", ec) ? "done.json" : "";
     case RunKind::kSami: {
-      // The whole budget (steps per env × training sets) in progress.csv, then every evaluation.
-      std::ifstream in(r.dir / "run.json");
-      const nlohmann::json run = nlohmann::json::parse(in, nullptr, false);
-      // A damaged run.json is no finished run (the seed runs again and its run says why).
-      if (!run.is_object() || !run.contains("steps_per_env") || !run.contains("training_sets") ||
-          !run["steps_per_env"].is_number_integer() || !run["training_sets"].is_number_integer()) {
-        return "";
+      // The whole budget in checkpoints/final.ckpt (a stopped run saves one too), then every
+      // evaluation.
+      const fs::path final_ckpt = r.dir / "checkpoints" / "final.ckpt";
+      if (!fs::exists(final_ckpt, ec)) return "";
+      try {
+        const train::SamiRunFile run = train::read_sami_run(r.dir);
+        if (learn::read_checkpoint_info(final_ckpt).steps < run.steps_per_env * run.envs) return "";
+      } catch (const std::exception&) {
+        return "";  // a damaged run is no finished run (the seed runs again and says why)
       }
-      const long total = run["steps_per_env"].get<long>() * run["training_sets"].get<long>();
-      if (last_row_steps(r.dir / "progress.csv") < total) return "";
       for (const std::string& split : r.line->eval_splits) {
         if (!fs::exists(r.dir / ("eval_" + split + ".json"), ec)) return "";
       }
-      return "progress.csv";
+      return "checkpoints/final.ckpt";
     }
     case RunKind::kTrain: {
       const fs::path final_ckpt = r.dir / "checkpoints" / "final.ckpt";
@@ -486,7 +475,7 @@ std::string continue_flag(const Line& line, const fs::path& dir) {
     case RunKind::kTma:
       return fs::exists(dir / "run.json", ec) ? "--resume" : "";
     case RunKind::kSami:
-      return fs::exists(dir / "checkpoint.ckpt", ec) ? "--resume" : "";
+      return fs::exists(dir / "checkpoints" / "latest.ckpt", ec) ? "--resume" : "";
     case RunKind::kTrain:
       if (fs::exists(dir / "checkpoints" / "latest.ckpt", ec)) return "--resume";
       return fs::exists(dir / "logs" / "progress.csv", ec) ? "--overwrite" : "";
@@ -616,7 +605,7 @@ std::string bash_continue_flag(RunKind kind) {
     case RunKind::kTma:
       return "  resume=; [ -e \"$dir/run.json\" ] && resume=--resume\n";
     case RunKind::kSami:
-      return "  resume=; [ -e \"$dir/checkpoint.ckpt\" ] && resume=--resume\n";
+      return "  resume=; [ -e \"$dir/checkpoints/latest.ckpt\" ] && resume=--resume\n";
     case RunKind::kTrain:
       return "  resume=\n"
              "  if [ -e \"$dir/checkpoints/latest.ckpt\" ]; then resume=--resume\n"

@@ -228,7 +228,7 @@ void register_learners(CLI::App& cmd) {
         "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "
         "last return %.3f\ncheckpoint: %s\n",
         r.run.string().c_str(), r.steps, r.updates, r.sps, r.gradient_steps_per_s, r.last_return,
-        (r.run / "checkpoint.ckpt").string().c_str());
+        r.checkpoint.string().c_str());
     if (r.stopped) {
       std::printf("stopped by a signal; continue with: cradle sami train --out %s --resume\n",
                   r.run.string().c_str());

@@ -30,7 +30,7 @@ void bind_sami_learn(py::module_& m) {
         d["sps"] = r.sps;
         d["gradient_steps_per_s"] = r.gradient_steps_per_s;
         d["last_return"] = r.last_return;
-        d["checkpoint"] = (r.run / "checkpoint.ckpt").string();
+        d["checkpoint"] = r.checkpoint.string();
         return d;
       },
       py::arg("env"), py::arg("method"), py::arg("seed"), py::arg("steps_per_env"),

@@ -470,6 +470,7 @@ TrainResult train(const Config& config, const TrainOptions& options) {
     csv.flush();
     if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
     rows.push_back(std::move(row));
+    if (options.on_report) options.on_report(s);
 
     // Only BabyBench scores behaviour.
     bar.show(

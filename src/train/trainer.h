@@ -71,6 +71,9 @@ struct TrainOptions {
   TeacherFactory teacher_factory;
   // Set (e.g. by a Ctrl-C handler) to stop after the current update with a final checkpoint.
   const std::atomic<bool>* stop = nullptr;
+  // Called with each progress row's stats (a data-parallel run's pooled over the ranks), after
+  // the row is written: e.g. `cradle sami train`'s summary of its gradient steps.
+  std::function<void(const learn::TrainStats&)> on_report;
   // A data-parallel run's ranks (docs/distributed.md); null or one rank: this process alone. Rank
   // r seeds with seed + r; rank 0 writes progress.csv, checkpoints, plots and the evaluation;
   // rank r > 0 logs its envs under <save_dir>/ranks/<r>/. The algorithms whose

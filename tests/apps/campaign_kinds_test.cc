@@ -152,7 +152,7 @@ TEST(CampaignKinds, DryRunPrintsEachKindsCommandsQuoted) {
   for (const char* expected :
        {"--no-progress --seed \"$seed\" --out \"$dir\" $resume",
         "sami evaluate --run \"$dir\" --split extreme --episodes 1 >> \"$dir/log.txt\"",
-        "[ -e \"$dir/checkpoint.ckpt\" ] && resume=--resume",
+        "[ -e \"$dir/checkpoints/latest.ckpt\" ] && resume=--resume",
         "--intrinsic '' --steps 256 --envs 1 --seed \"$seed\" --save-dir \"$dir\" $resume",
         "elif [ -e \"$dir/logs/progress.csv\" ]; then resume=--overwrite; fi",
         "--exp_name t --seed \"$seed\" --out \"$dir\" $resume",
@@ -230,7 +230,7 @@ TEST(CampaignKinds, TinySamiAndBabyBenchCampaignsRunAndAnalyze) {
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("--resume: 4 finished seeds skipped"), std::string::npos) << r.out;
   EXPECT_NE(read(train0 / "finished").find("checkpoints/final.ckpt"), std::string::npos);
-  EXPECT_NE(read(sami0 / "finished").find("progress.csv"), std::string::npos);
+  EXPECT_NE(read(sami0 / "finished").find("checkpoints/final.ckpt"), std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -172,8 +172,10 @@ TEST(CliVocabulary, EveryTrainingCommandSpeaksTheSameFlags) {
       "sami train --env CrippleHalfCheetah --algo tesac --steps 300 --no-progress --out " +
       (dir / "sami").string());
   ASSERT_EQ(sami.status, 0) << sami.out;
-  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"steps_per_env\": 100"), std::string::npos);
-  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"method\": \"TESAC\""), std::string::npos);
+  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"steps\": 300"), std::string::npos);
+  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"envs\": 3"), std::string::npos);
+  EXPECT_NE(read_text(dir / "sami" / "run.json").find("\"algorithm\": \"tesac\""),
+            std::string::npos);
   // A finished run is replaced only when asked.
   const std::string again = "sami train --env CrippleHalfCheetah --steps 300 --no-progress --out " +
                             (dir / "sami").string();

@@ -41,7 +41,7 @@ TEST(HyperparamCli, SamiTrainRefusesSizesBeyondMemoryAndRepeatedNames) {
       {"--hp buffer_size=10 --hp buffer_size=20", "--hp buffer_size is given twice"}};
   for (const auto& [hp, expected] : cases) expect_error(train + " " + hp, expected);
   // Nothing was started: no checkpoint to resume from.
-  EXPECT_FALSE(fs::exists(dir / "run" / "checkpoint.ckpt"));
+  EXPECT_FALSE(fs::exists(dir / "run" / "checkpoints" / "latest.ckpt"));
   fs::remove_all(dir);
 }
 

@@ -1,10 +1,11 @@
-// `cradle sami`: commands run, a stopped run exits 130 with a checkpoint that resumes, and wrong
-// input is a one-line error with exit status 1.
+// `cradle sami`: commands run, a stopped run exits 130 with a checkpoint that resumes, a run killed
+// and resumed ends as an uninterrupted one, and wrong input is a one-line error with exit status 1.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,22 +40,58 @@ TEST(SamiCli, StopSignalSavesAndExits130) {
       " --hp net_arch=32,32 --hp lstm_hidden=16 --hp batch_size=4 --hp contrast_batch_size=4"
       " --hp buffer_size=8 --hp train_freq=50 --hp gradient_steps=1 --hp learning_starts=60";
   RunResult r = cradle::test::run_cradle_then_signal(args + " --steps-per-env 1000000",
-                                                     dir / "progress.csv", "TERM");
+                                                     dir / "logs" / "progress.csv", "TERM");
   ASSERT_EQ(r.status, 130) << r.out;
   EXPECT_NE(r.out.find("stopped by a signal; continue with: cradle sami train --out"),
             std::string::npos)
       << r.out;
-  ASSERT_TRUE(fs::exists(dir / "checkpoint.ckpt"));
+  ASSERT_TRUE(fs::exists(dir / "checkpoints" / "latest.ckpt"));
   // The row at the stop is the last one; resuming runs on to one more row.
-  const std::vector<std::string> rows = read_lines(dir / "progress.csv");
+  const std::vector<std::string> rows = read_lines(dir / "logs" / "progress.csv");
   ASSERT_GE(rows.size(), 2u);
   const long stopped_at = std::stol(rows.back().substr(0, rows.back().find(',')));
   EXPECT_LT(stopped_at, 6'000'000);
   r = run_cradle("sami train --out " + dir.string() + " --resume --no-progress --steps-per-env " +
                  std::to_string(stopped_at / 6 + 50));
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_GT(read_lines(dir / "progress.csv").size(), rows.size());
+  EXPECT_GT(read_lines(dir / "logs" / "progress.csv").size(), rows.size());
   fs::remove_all(dir);
+}
+
+std::string read_bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// kill -9 after a checkpoint, then --resume: the same final checkpoint, byte for byte, as a run
+// never interrupted (the checkpoint holds the trajectory rings and every generator, and each
+// checkpoint starts fresh episodes in both runs).
+TEST(SamiCli, KillNineThenResumeEqualsUninterruptedRun) {
+  const fs::path killed = cradle::test::fresh_dir("sami_cli_killed");
+  const fs::path whole = cradle::test::fresh_dir("sami_cli_whole");
+  const auto args = [](const fs::path& dir) {
+    return "sami train --env PandaPush --method SaCCM --seed 2 --no-progress --out " +
+           dir.string() +
+           " --hp net_arch=32,32 --hp lstm_hidden=16 --hp batch_size=4 --hp "
+           "contrast_batch_size=4 --hp buffer_size=8 --hp train_freq=10 --hp gradient_steps=1 "
+           "--hp learning_starts=60 --checkpoint-every 100";
+  };
+  // Past the first checkpoint (100 steps per env; a row every 50), then SIGKILL.
+  const bool ready =
+      cradle::test::run_cradle_then_kill(args(killed) + " --steps-per-env 1000000", [&] {
+        return fs::exists(killed / "checkpoints" / "latest.ckpt") &&
+               read_lines(killed / "logs" / "progress.csv").size() >= 4;
+      });
+  ASSERT_TRUE(ready) << "training never passed its first checkpoint";
+  RunResult r = run_cradle(args(killed) + " --resume --steps-per-env 1000");
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = run_cradle(args(whole) + " --steps-per-env 1000");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(read_lines(killed / "logs" / "progress.csv").size(), 1u + 1000 / 50);
+  EXPECT_EQ(read_bytes(killed / "checkpoints" / "final.ckpt"),
+            read_bytes(whole / "checkpoints" / "final.ckpt"));
+  fs::remove_all(killed);
+  fs::remove_all(whole);
 }
 
 TEST(SamiCli, WrongInputIsOneLineError) {

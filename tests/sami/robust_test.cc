@@ -206,15 +206,15 @@ TEST(SamiRobust, TableRefusesTheSameRunTwice) {
 
 // run.json as `cradle sami train` writes it (no checkpoint: every check comes before it is read).
 fs::path trained_run(const fs::path& dir, const std::string& json) {
-  fs::create_directories(dir);
+  fs::create_directories(dir / "logs");
   write(dir / "run.json", json);
-  write(dir / "progress.csv", "steps\n6\n");
+  write(dir / "logs" / "progress.csv", "global_step\n6\n");
   return dir;
 }
 
 const char* const kRunJson =
-    R"({"env": "PandaPush", "method": "SaCCM", "seed": 7, "steps_per_env": 100,
-        "hyperparameters": {"batch_size": "4"}, "config": "", "training_sets": 6})";
+    R"({"env": "sami/PandaPush:train", "family": "sami", "algorithm": "saccm", "seed": 7,
+        "steps": 600, "envs": 6, "hyperparameters": {"batch_size": "4"}})";
 
 TEST(SamiRobust, ResumeRefusesAnotherEnvMethodOrSeed) {
   const fs::path dir = cradle::test::fresh_dir("sami_robust_resume");
@@ -229,8 +229,14 @@ TEST(SamiRobust, ResumeRefusesAnotherEnvMethodOrSeed) {
   expect_refused(resume + " --seed 8",
                  {file, "is a run of --seed 7, not --seed 8", "leave --seed out"});
   expect_refused(resume + " --env PandaPush --method SaCCM --seed 7 --steps-per-env 200",
-                 {(run / "checkpoint.ckpt").string()});  // the same ones pass the checks
+                 {(run / "checkpoints" / "latest.ckpt").string()});  // they pass the checks
   EXPECT_EQ(snapshot(dir), before);
+  // A `cradle train` run of another split continues there.
+  std::string other = kRunJson;
+  other.replace(other.find(":train"), 6, ":moderate");
+  write(run / "run.json", other);
+  expect_refused(resume, {"is a run of sami/PandaPush:moderate on 6 envs, not of SaMI's training",
+                          "cradle train --env sami/PandaPush:moderate"});
   fs::remove_all(dir);
 }
 
@@ -238,25 +244,33 @@ TEST(SamiRobust, BadRunJsonIsOneLineErrorNamingTheKey) {
   const fs::path dir = cradle::test::fresh_dir("sami_robust_runjson");
   const fs::path run = dir / "run";
   const std::string file = (run / "run.json").string();
+  // Every key right but the one each case names.
+  const auto run_json = [](const std::string& env, const std::string& algorithm,
+                           const std::string& seed, const std::string& steps,
+                           const std::string& hyperparameters = "{}") {
+    return R"({"env": ")" + env + R"(", "family": "sami", "algorithm": ")" + algorithm +
+           R"(", "seed": )" + seed + R"(, "steps": )" + steps +
+           R"(, "envs": 6, "hyperparameters": )" + hyperparameters + "}";
+  };
+  const std::string panda = "sami/PandaPush:train";
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {R"({"env": "PandaPush", "method": "SaCCM", "seed": "x", "steps_per_env": 100,
-           "hyperparameters": {}})",
+      {run_json(panda, "saccm", "\"x\"", "600"),
        "\"seed\" is \"x\"; expected an integer from 0 to 18446744073709551615"},
-      {R"({"env": "PandaPush", "method": "SaCCM", "seed": -1, "steps_per_env": 100,
+      {run_json(panda, "saccm", "-1", "600"), "\"seed\" is -1; expected an integer"},
+      {R"({"env": "sami/PandaPush:train", "family": "sami", "seed": 1, "steps": 600, "envs": 6,
            "hyperparameters": {}})",
-       "\"seed\" is -1; expected an integer"},
-      {R"({"env": "PandaPush", "seed": 1, "steps_per_env": 100, "hyperparameters": {}})",
-       "has no key \"method\"; expected a string"},
-      {R"({"env": "PandaPush", "method": "SaCCM", "seed": 1, "steps_per_env": 0,
-           "hyperparameters": {}})",
-       "\"steps_per_env\" is 0; expected a positive integer"},
-      {R"({"env": "PandaPush", "method": "SaCCM", "seed": 1, "steps_per_env": 100,
-           "hyperparameters": {"batch_size": 4}})",
+       "has no key \"algorithm\"; expected a string"},
+      {run_json(panda, "saccm", "1", "0"), "\"steps\" is 0; expected a positive integer"},
+      {run_json(panda, "saccm", "1", "600", R"({"batch_size": 4})"),
        "\"hyperparameters\" is {\"batch_size\":4}; expected an object of"},
-      {R"({"env": "Cheetah", "method": "SaCCM", "seed": 1, "steps_per_env": 100,
+      {run_json("sami/Cheetah:train", "saccm", "1", "600"), "unknown SaMI env 'Cheetah'"},
+      {run_json("mimo/reach", "saccm", "1", "600"), "is not a SaMI env"},
+      {run_json(panda, "ppo", "1", "600"), "algorithm 'ppo' is not one of SaMI's learners"},
+      {R"({"env": "PandaPush", "method": "SaCCM", "seed": 1, "steps_per_env": 100,
            "hyperparameters": {}})",
-       "unknown SaMI env 'Cheetah'"},
-      {R"({"env": "PandaPush", "method": "SaCCM", "seed": 1, "steps_per_en)", "is not valid JSON"},
+       "is an earlier `cradle sami train` run"},
+      {R"({"env": "sami/PandaPush:train", "family": "sami", "seed": 1, "steps_per_en)",
+       "is not valid JSON"},
       {"[]", "is not a JSON object"},
   };
   for (const auto& [json, says] : cases) {

@@ -1,6 +1,7 @@
 #include "envs/sami/sami_env.h"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 #include "core/error.h"
@@ -63,6 +64,11 @@ void SamiEnvAdapter::copy_observation() {
 void SamiEnvAdapter::reset(std::optional<std::uint64_t> seed) {
   env_->reset(seed);
   copy_observation();
+}
+
+double SamiEnvAdapter::score() const {
+  if (env_->spec().id != sami::EnvId::kPandaPush) return std::numeric_limits<double>::quiet_NaN();
+  return env_->info().is_success ? 1.0 : 0.0;
 }
 
 StepResult SamiEnvAdapter::step(std::span<const double> action) {

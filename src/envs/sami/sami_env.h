@@ -30,6 +30,9 @@ class SamiEnvAdapter final : public Env {
   // still drawn from the sets); UserError for a name the env does not vary or a value out of
   // range, before anything changes.
   void set_reset_options(const ResetOptions& options) override;
+  // Panda push's success so far (1 or 0: the cube within 5 cm of the goal); NaN for locomotion,
+  // which has no success rule.
+  double score() const override;
   sami::SamiEnv& sami() { return *env_; }
 
  private:

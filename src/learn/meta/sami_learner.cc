@@ -46,7 +46,7 @@ constexpr std::array<std::string_view, 5> kNames = {"tesac", "ccm", "satesac", "
 constexpr std::array<std::string_view, 5> kMethods = {"TESAC", "CCM", "SaTESAC", "SaCCM",
                                                       "SaCCMAll"};
 
-// sami_train's stream for random actions and replay sampling, apart from ContextSac's generator.
+// SaMI's stream for random actions and replay sampling, apart from ContextSac's generator.
 constexpr std::uint64_t kRngSalt = 0x5a4d49ULL;
 
 // Rng's state in checkpoints: four words, copied as they lie.
@@ -79,7 +79,7 @@ Settings parse_settings(const std::string& algorithm, const LearnerOptions& opti
   settings.own.bind(table);
   table.apply(options.hyperparameters);
   settings.sami.check();
-  // Values SamiConfig::check leaves to sami_train's loop (the ranges of hyperparam_ranges.h hold
+  // Values SamiConfig::check leaves to the loop (the ranges of hyperparam_ranges.h hold
   // for values given by name, not for defaults).
   const auto need = [&](bool ok, const std::string& what) {
     if (!ok) throw UserError(algorithm + ": hyperparameter " + what);
@@ -203,9 +203,15 @@ class SamiLearner final : public Learner {
            bool deterministic) override {
     if (act_steps_ == settings_.own.horizon) new_episode();
     gather(observation, act_observation_.data_ptr<float>());
-    const torch::Tensor a = sac_.act(act_observation_, act_stream_, deterministic).first;
+    auto [a, context] = sac_.act(act_observation_, act_stream_, deterministic);
+    act_context_ = context.contiguous();
     ++act_steps_;
     rescale(a.contiguous().data_ptr<float>(), action);
+  }
+
+  std::span<const float> context() const {
+    if (!act_context_.defined()) return {};
+    return {act_context_.data_ptr<float>(), static_cast<size_t>(act_context_.numel())};
   }
 
   void new_episode() override {
@@ -234,8 +240,8 @@ class SamiLearner final : public Learner {
     }
   }
 
-  // Actions in [-1, 1] to the Box, as sami_train's low + (a + 1) (high - low) / 2, then clipped
-  // to the bounds (a no-op on [-1, 1], whose values stay sami_train's exactly).
+  // Actions in [-1, 1] to the Box, as SaMI's low + (a + 1) (high - low) / 2, then clipped
+  // to the bounds (a no-op on [-1, 1], whose values stay SaMI's exactly).
   template <typename T>
   void rescale(const T* actions, std::span<double> out) const {
     for (size_t k = 0; k < out.size(); ++k) {
@@ -283,6 +289,7 @@ class SamiLearner final : public Learner {
   ContextSac::Streams streams_, act_stream_;
   torch::Tensor observations_;       // [envs, obs] float32: the current observations
   torch::Tensor act_observation_;    // [1, obs]
+  torch::Tensor act_context_;        // [1, context]: the last act() call's c_t
   std::vector<float> first_;         // [envs, obs]: each slot's next trajectory's first observation
   std::vector<std::uint8_t> fresh_;  // 1: the slot's trajectory is not in its ring yet
   std::vector<double> actions_;      // [envs, action] in [-1, 1]
@@ -290,6 +297,8 @@ class SamiLearner final : public Learner {
   std::vector<double> low_, high_, scale_;  // per action: bounds, (high - low) / 2
   long steps_ = 0, vector_steps_ = 0;
   int act_steps_ = 0;                                       // act() calls in the current stream
+  long window_updates_ = 0;                                 // gradient steps since the last report
+  double update_seconds_ = 0;                               // their time
   std::map<std::string, std::pair<double, long>> records_;  // sum and count since the report
 };
 
@@ -313,7 +322,7 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
   }
 
   while (steps_ < total_steps) {
-    // Act: the policy advances every stream (random steps too, as sami_train); until
+    // Act: the policy advances every stream (random steps too, as SaMI's loop); until
     // learning_starts the actions taken are uniform and replace the streams' previous actions.
     const torch::Tensor policy = sac_.act(observations_, streams_, /*deterministic=*/false).first;
     float* taken = streams_.prev_actions.data_ptr<float>();
@@ -375,6 +384,7 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
 }
 
 void SamiLearner::train() {
+  const Clock::time_point start = Clock::now();
   for (int g = 0; g < config_.gradient_steps; ++g) {
     const ContextSac::Losses l = sac_.update(replay_, rng_);
     if (!std::isfinite(l.critic) || !std::isfinite(l.actor)) {
@@ -391,6 +401,8 @@ void SamiLearner::train() {
     record("sance_loss", l.sance);
     record("sance_weight", l.weight);
   }
+  window_updates_ += config_.gradient_steps;
+  update_seconds_ += std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 TrainStats SamiLearner::report(Clock::time_point start, long start_steps) {
@@ -398,6 +410,9 @@ TrainStats SamiLearner::report(Clock::time_point start, long start_steps) {
   for (const auto& [name, record] : records_) stats.losses[name] = record.first / record.second;
   records_.clear();
   stats.losses["updates"] = static_cast<double>(sac_.updates());  // gradient steps so far
+  // This report's gradient steps and the seconds they took (as the off-policy learners' columns).
+  stats.losses["gradient_steps"] = static_cast<double>(std::exchange(window_updates_, 0));
+  stats.losses["update_seconds"] = std::exchange(update_seconds_, 0.0);
   long trajectories = 0;
   for (int i = 0; i < envs_; ++i) trajectories += replay_.stored(i);
   stats.losses["buffer_trajectories"] = static_cast<double>(trajectories);
@@ -416,6 +431,16 @@ std::string_view sami_method(std::string_view algorithm) {
     if (kNames[k] == algorithm) return kMethods[k];
   }
   return {};
+}
+
+std::span<const float> last_context(const Learner& learner) {
+  const auto* sami = dynamic_cast<const SamiLearner*>(&learner);
+  if (sami == nullptr) {
+    throw UserError(std::string(learner.algorithm()) +
+                    " infers no context (expected one of SaMI's learners: tesac, ccm, satesac, "
+                    "saccm or saccm_all)");
+  }
+  return sami->context();
 }
 
 std::unique_ptr<Learner> make_sami_learner(std::string_view algorithm, VecEnv& env,

@@ -1,7 +1,7 @@
 // SaMI's context-SAC methods (TESAC, CCM, SaTESAC, SaCCM, SaCCMAll; learn/meta/context_sac.h) as
 // ordinary learners (learn/learner.h), built by name in learn/registry.h: "tesac", "ccm",
 // "satesac", "saccm", "saccm_all". They collect whole trajectories from any VecEnv with SaMI's
-// loop (train/sami/sami_train.cc), one trajectory ring per env slot (env i -> replay env i):
+// loop, one trajectory ring per env slot (env i -> replay env i):
 //
 //   every learn() call: reset the envs (seed from the learner's generator); an open trajectory
 //     is closed as truncated; every slot starts a trajectory at its first observation and a
@@ -22,14 +22,15 @@
 //       SaNCE step) on trajectories sampled from the rings with rng
 //     every report_every vector steps and at the end: TrainStats
 //
-// On SaMI's envs (one per training task set, actions in [-1, 1]) this stores what sami_train
-// stores, drawing from the same generators (ContextSac's seeded with the learner's seed, rng with
-// seed ^ 0x5a4d49): trajectories and updates are sami_train's bitwise up to the first episode
-// end. After it the timing differs: a VecEnv resets an env in the step after the one that ended
-// its episode (sami_train's vector in the same step), so each reset costs a vector step, and a
-// ring gives up its oldest trajectory's slot at the new trajectory's first step rather than at
-// the reset. The envs' reset seeds come from the learner's own generator (seeded with the seed),
-// which draws nothing else.
+// On SaMI's envs (one per training task set, actions in [-1, 1]) this is SaMI's training loop but
+// for one rule: SaMI's vector resets an env in the step that ends its episode, a VecEnv in the
+// next step, so each reset costs a vector step and a ring gives up its oldest trajectory's slot at
+// the new trajectory's first step rather than at the reset. Up to the first episode end the data
+// and updates are those of SaMI's loop drawing from the same generators (ContextSac's seeded with
+// the learner's seed, rng with seed ^ 0x5a4d49); the learning curves of both rules are compared in
+// docs/fidelity.md. The envs' reset seeds come from the learner's own generator (seeded with the
+// seed), which draws nothing else. `cradle sami train` runs these learners through `cradle
+// train`'s path (train/sami/sami_train.h).
 //
 // Settings: SamiConfig (context_sac.h; defaults SaMI's MuJoCo ones, Panda's buffer_size,
 // batch_size and contrast_batch_size of 1000, 256, 256 come as hyperparameters) plus:
@@ -72,5 +73,10 @@ std::string_view sami_method(std::string_view algorithm);
 // bounds, CCM on fewer than two envs, or a replay too large for the machine.
 std::unique_ptr<Learner> make_sami_learner(std::string_view algorithm, VecEnv& env,
                                            const LearnerOptions& options);
+
+// The context c_t the encoder inferred at the learner's last act() call (SamiConfig's
+// context_size floats; empty before the first), for evaluations that record what the encoder
+// infers (`cradle sami evaluate`). Valid until the next act(). UserError for another learner.
+std::span<const float> last_context(const Learner& learner);
 
 }  // namespace cradle::learn::meta

@@ -1,9 +1,13 @@
 // SaMI training, evaluation and tables (tma_sami.md §6-§8): `cradle sami train / evaluate / table`
 // and cradle.sami.train / evaluate in Python.
 //
-// A run folder holds run.json (env, method, seed, budget, hyperparameters), progress.csv,
-// checkpoint.ckpt (sealed, written every checkpoint_every env steps per env and at the end) and,
-// after evaluation, eval_<split>.json / .csv and contexts_<split>.csv.
+// `sami train` is `cradle train` (train/trainer.h) with SaMI's flags: the env's training task sets
+// one per env (sami/<Env>:train), the method's learner (learn/meta/sami_learner.h: SaCCM is
+// "saccm"), no intrinsic reward, and SaMI's budget, horizon and batch sizes. Its folder is a
+// `cradle train` run's: run.json, logs/progress.csv and checkpoints/{step_<n>,latest,final}.ckpt
+// (every checkpoint_every env steps per env and at the end); `sami evaluate` adds
+// eval_<split>.json / .csv and contexts_<split>.csv. `cradle train --env sami/<Env> --algo saccm`
+// makes the same folder, which `sami evaluate` reads too.
 #pragma once
 
 #include <atomic>
@@ -25,38 +29,44 @@ struct SamiTrainOptions {
   std::string env = "PandaPush";
   std::string method = "SaCCM";
   std::uint64_t seed = 0;  // on resume the run's (run.json)
-  long steps_per_env = 0;  // 0: SaMI's budget (500,000; PandaPush 1,000,000)
+  long steps_per_env = 0;  // 0: SaMI's budget (500,000; PandaPush 1,000,000); on resume the run's
   long steps = 0;          // > 0: env steps in all instead (rounded up to a multiple of the envs)
   std::map<std::string, std::string> hyperparameters;
   std::filesystem::path out;        // run folder; empty: runs/sami/<env>_<method>_<seed>
   bool resume = false;              // continue the run in `out` from its checkpoint
   bool overwrite = false;           // replace a run already in `out` (else refused)
   long checkpoint_every = 100'000;  // env steps per training env between checkpoints
-  long report_every = 0;            // vector steps between progress rows (0: one episode length)
+  // Vector steps between progress rows (0: one episode length; on resume the run's).
+  long report_every = 0;
   bool progress_bar = true;
-  // Set (e.g. by Ctrl-C) to stop after the current vector step with a checkpoint and a progress
-  // row, so that --resume continues from there.
+  // Set (e.g. by Ctrl-C) to stop at the next progress row with a checkpoint, so that --resume
+  // continues from there.
   const std::atomic<bool>* stop = nullptr;
 };
 
 struct SamiTrainResult {
   std::filesystem::path run;
-  long steps = 0;                   // env steps (all sub-envs)
-  long updates = 0;                 // gradient steps
-  double sps = 0;                   // env steps per second, whole run of this call
-  double gradient_steps_per_s = 0;  // gradient steps per second of update time
-  double last_return = 0;           // mean return of the episodes of the last report
-  bool stopped = false;             // ended by `stop` before the budget
+  long steps = 0;                    // env steps (all sub-envs)
+  long updates = 0;                  // gradient steps
+  double sps = 0;                    // env steps per second, whole run of this call
+  double gradient_steps_per_s = 0;   // gradient steps per second of update time
+  double last_return = 0;            // mean return of the episodes of the last report
+  bool stopped = false;              // ended by `stop` before the budget
+  std::filesystem::path checkpoint;  // checkpoints/final.ckpt
 };
 SamiTrainResult sami_train(const SamiTrainOptions& options);
 
-// A run folder's run.json with every key's type checked, and the env and method names known: a
-// missing or bad file, key or value is a one-line UserError naming run.json and the key.
+// A SaMI run folder's run.json (`cradle train`'s) with every key's type checked, a SaMI env and
+// learner: a missing or bad file, key or value is a one-line UserError naming run.json and the key.
 struct SamiRunFile {
-  std::string env, method;
+  std::string env_id;     // "sami/CrippleHalfCheetah:train"
+  std::string env;        // "CrippleHalfCheetah"
+  std::string algorithm;  // "saccm"
+  std::string method;     // "SaCCM"
   std::uint64_t seed = 0;
-  long steps_per_env = 0;
-  std::map<std::string, std::string> hyperparameters;
+  long envs = 0;                                       // training envs
+  long steps_per_env = 0;                              // the budget per env
+  std::map<std::string, std::string> hyperparameters;  // the values given
 };
 SamiRunFile read_sami_run(const std::filesystem::path& run);
 

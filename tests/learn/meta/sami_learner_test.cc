@@ -1,6 +1,6 @@
 // SaMI's methods as ordinary learners (learn/meta/sami_learner.h): built by name, trained on SaMI
 // envs, TeachMyAgent and a MuJoCo task with next-step autoresets, checkpoints that continue
-// exactly, sami_train's data on SaMI's vectors, and the one-line refusals.
+// exactly, the context of each act() call, and the one-line refusals.
 #include "learn/meta/sami_learner.h"
 
 #include <gtest/gtest.h>
@@ -26,7 +26,6 @@
 #include "learn/test_tasks.h"
 #include "learn/vector_env.h"
 #include "sami/env.h"
-#include "train/sami/sami_train.h"
 
 namespace cradle::learn::meta {
 namespace {
@@ -192,6 +191,29 @@ TEST(SamiLearner, SaveLoadContinuesExactlyAsTheSavedLearner) {
   std::filesystem::remove_all(dir);
 }
 
+// act() keeps the context it inferred: SamiConfig's context_size floats; a fresh episode starts a
+// zeroed stream again, so the same observation gives the same context, and a step later another.
+TEST(SamiLearner, ActKeepsTheContextItInferred) {
+  auto vec = sami_envs(2, 5);
+  vec->reset(5);
+  auto learner = make_learner("saccm", *vec, {.seed = 5, .hyperparameters = tiny_hp()});
+  EXPECT_TRUE(last_context(*learner).empty());
+  const int size = std::stoi(parse_hyperparameter_text(learner->config_text()).at("context_size"));
+  std::vector<double> action(vec->action_space().size());
+  learner->act(vec->observation(0), action, /*deterministic=*/true);
+  const std::vector<float> first(last_context(*learner).begin(), last_context(*learner).end());
+  ASSERT_EQ(static_cast<int>(first.size()), size);
+  learner->act(vec->observation(0), action, /*deterministic=*/true);
+  const std::vector<float> second(last_context(*learner).begin(), last_context(*learner).end());
+  EXPECT_NE(second, first);
+  learner->new_episode();
+  learner->act(vec->observation(0), action, /*deterministic=*/true);
+  EXPECT_EQ(std::vector<float>(last_context(*learner).begin(), last_context(*learner).end()),
+            first);
+  auto ppo = make_learner("ppo", *vec, {});
+  EXPECT_TRUE(one_line(user_error([&] { last_context(*ppo); })));
+}
+
 TEST(SamiLearner, TesacTrainsOnTeachMyAgent) {
   std::vector<std::unique_ptr<envs::Env>> list;
   for (int i = 0; i < 2; ++i)
@@ -238,68 +260,6 @@ TEST(SamiLearner, NextStepAutoresetStoresEachEpisodeOnceWithTheHookedRewards) {
   EXPECT_EQ(last.losses.at("buffer_trajectories"), last.episodes);
   EXPECT_DOUBLE_EQ(last.episodic_return, 2 * last.episodic_length);  // reward 1, hook 1
   EXPECT_GT(last.losses.at("updates"), 0);
-}
-
-// Env i of sami_train's vector (task set i, reset with seed + i), as a VecEnv slot: the vector's
-// reset seed is ignored.
-class FixedSeedEnv final : public envs::Env {
- public:
-  FixedSeedEnv(std::unique_ptr<envs::Env> env, std::uint64_t seed)
-      : env_(std::move(env)), seed_(seed) {}
-  const DictSpace& observation_space() const override { return env_->observation_space(); }
-  const Box& action_space() const override { return env_->action_space(); }
-  void reset(std::optional<std::uint64_t> seed) override {
-    env_->reset(seed ? std::optional<std::uint64_t>(seed_) : std::nullopt);
-  }
-  envs::StepResult step(std::span<const double> action) override { return env_->step(action); }
-  const envs::ObservationBuffers& observation() const override { return env_->observation(); }
-  const envs::Info& info() const override { return env_->info(); }
-
- private:
-  std::unique_ptr<envs::Env> env_;
-  std::uint64_t seed_;
-};
-
-// Up to the first episode end the learner's data and updates are sami_train's: CrippleHalfCheetah's
-// three training sets, 1000-step episodes, the first update at step 1000 of each env.
-TEST(SamiLearner, MatchesSamiTrainUpToTheFirstEpisodeEnd) {
-  const std::uint64_t seed = 11;
-  std::map<std::string, std::string> hp{
-      {"net_arch", "16"},           {"lstm_hidden", "4"},       {"batch_size", "3"},
-      {"contrast_batch_size", "4"}, {"buffer_size", "2"},       {"train_freq", "10"},
-      {"gradient_steps", "2"},      {"learning_starts", "100"}, {"adversarial_loss_coef", "1"}};
-  // LibTorch's and OpenBLAS's thread counts are process-wide and change float sums; a learner
-  // sets both to one (learn::apply_torch_options, as `cradle` does at start), so sami_train runs
-  // with one too, alone (ctest runs each test in its own process) as after the other tests.
-  learn::apply_torch_options({.torch_threads = 1});
-  const auto dir = scratch("sami_train");
-  train::sami_train({.env = "CrippleHalfCheetah",
-                     .method = "SaCCM",
-                     .seed = seed,
-                     .steps_per_env = 1000,
-                     .hyperparameters = hp,
-                     .out = dir / "run",
-                     .progress_bar = false});
-  const sami::EnvId id = sami::env_from_name("CrippleHalfCheetah");
-  const sami::Spec spec = sami::env_spec(id);
-  SamiConfig config;
-  apply_sami_hyperparameters(config, hp);
-  ContextSac reference("SaCCM", spec.obs_size, spec.action_size, config, 0);
-  EXPECT_EQ(reference.load(dir / "run" / "checkpoint.ckpt"), 3000);
-  ASSERT_EQ(reference.updates(), 2);
-
-  const std::vector<sami::TaskSet> sets = train::sami_training_sets(id);
-  std::vector<std::unique_ptr<envs::Env>> list;
-  for (size_t i = 0; i < sets.size(); ++i) {
-    auto env = std::make_unique<envs::SamiEnvAdapter>(sami::make_env(id, {sets[i]}, 0));
-    list.push_back(std::make_unique<FixedSeedEnv>(std::move(env), seed + i));
-  }
-  ThreadedVecEnv vec(std::move(list), /*threads=*/1);
-  hp["horizon"] = std::to_string(spec.horizon);
-  auto learner = make_learner("saccm", vec, {.seed = seed, .hyperparameters = hp});
-  learner->learn(3000, {});
-  EXPECT_EQ(learner->parameter_hash(), tensor_hash(reference.parameters()));
-  std::filesystem::remove_all(dir);
 }
 
 class TwoRanks final : public GradSync {

@@ -1,5 +1,6 @@
-// The SaMI train / evaluate / table loop: a few-hundred-step run of every method on Panda push
-// and on a crippled locomotion env, resume, evaluation files and the table.
+// SaMI's train / evaluate / table: a few-hundred-step run of every method on Panda push and on a
+// crippled locomotion env, the same run as `cradle train`'s, resume, evaluation files and the
+// table.
 #include "train/sami/sami_train.h"
 
 #include <gtest/gtest.h>
@@ -12,7 +13,9 @@
 #include <string>
 
 #include "core/error.h"
+#include "learn/checkpoint.h"
 #include "learn/meta/samplers.h"
+#include "train/trainer.h"
 
 namespace cradle::train {
 namespace {
@@ -58,11 +61,54 @@ TEST(SamiTrain, EveryMethodRunsOnPandaAndACrippledEnv) {
       const int envs = env == "PandaPush" ? 6 : 3;  // CrippleHalfCheetah: one set per joint
       EXPECT_EQ(r.steps, (env == "PandaPush" ? 200 : 1040) * envs) << env << method;
       EXPECT_GT(r.updates, 0) << env << method;
-      EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.ckpt"));
-      EXPECT_GE(lines(dir / "progress.csv"), 2);
+      EXPECT_TRUE(std::filesystem::exists(dir / "checkpoints" / "final.ckpt"));
+      EXPECT_EQ(r.checkpoint, dir / "checkpoints" / "final.ckpt");
+      EXPECT_GE(lines(dir / "logs" / "progress.csv"), 2);
       std::filesystem::remove_all(dir);
     }
   }
+}
+
+std::string bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// `sami train` is `cradle train --env sami/<Env> --algo <learner>` with SaMI's settings: one env
+// per training set on one thread, no intrinsic reward, the env's horizon; both runs end with the
+// same checkpoint bytes.
+TEST(SamiTrain, IsCradleTrainWithSamisSettings) {
+  const auto dir = scratch("front");
+  auto hp = tiny_hp();
+  const SamiTrainResult r = sami_train({.env = "PandaPush",
+                                        .method = "SaTESAC",
+                                        .seed = 6,
+                                        .steps_per_env = 120,
+                                        .hyperparameters = hp,
+                                        .out = dir / "sami",
+                                        .progress_bar = false});
+  EXPECT_EQ(r.steps, 720);
+  Config config;
+  config.save_dir = (dir / "train").string();
+  hp["horizon"] = "50";  // Panda's episodes; a progress row per episode length
+  hp["report_every"] = "50";
+  const TrainResult t = train(config, {.env = "sami/PandaPush",
+                                       .algorithm = "satesac",
+                                       .intrinsic = "",
+                                       .steps = 720,
+                                       .envs = 6,
+                                       .threads = 1,
+                                       .seed = 6,
+                                       .hyperparameters = hp,
+                                       .eval_episodes = 0,
+                                       .progress_bar = false});
+  EXPECT_EQ(t.steps, 720);
+  EXPECT_EQ(learn::read_checkpoint_info(r.checkpoint).config,
+            learn::read_checkpoint_info(t.checkpoint).config);
+  EXPECT_EQ(bytes(r.checkpoint), bytes(t.checkpoint));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
@@ -81,7 +127,8 @@ TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
   o.steps_per_env = 200;
   const SamiTrainResult r = sami_train(o);
   EXPECT_EQ(r.steps, 1200);
-  EXPECT_EQ(lines(dir / "progress.csv"), 1 + 200 / 25);  // header + one row per 25 vector steps
+  // header + one row per 25 vector steps
+  EXPECT_EQ(lines(dir / "logs" / "progress.csv"), 1 + 200 / 25);
 
   const SamiEvalResult e = sami_evaluate({.run = dir, .split = "extreme", .episodes = 1});
   ASSERT_EQ(e.cells.size(), 8u);  // Panda's 8 extreme cells
@@ -146,8 +193,8 @@ TEST(SamiEvaluate, ContextRowsNameTheDrawnTask) {
   std::filesystem::remove_all(dir);
 }
 
-// A stop request (Ctrl-C) ends the run after the current vector step with a checkpoint and a
-// progress row at that step; --resume continues from it to the budget.
+// A stop request (Ctrl-C, here before the first step) ends the run with a checkpoint; --resume
+// continues from it to the budget.
 TEST(SamiTrain, StopWritesACheckpointThatResumes) {
   const auto dir = scratch("stop");
   std::atomic<bool> stop{true};
@@ -163,15 +210,15 @@ TEST(SamiTrain, StopWritesACheckpointThatResumes) {
                      .stop = &stop};
   const SamiTrainResult stopped = sami_train(o);
   EXPECT_TRUE(stopped.stopped);
-  EXPECT_EQ(stopped.steps, 6);  // one vector step of Panda's 6 training envs
-  EXPECT_TRUE(std::filesystem::exists(dir / "checkpoint.ckpt"));
-  EXPECT_EQ(lines(dir / "progress.csv"), 2);  // header + the row at the stop
+  EXPECT_EQ(stopped.steps, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "checkpoints" / "latest.ckpt"));
+  EXPECT_EQ(lines(dir / "logs" / "progress.csv"), 1);  // the header
   stop = false;
   o.resume = true;
   const SamiTrainResult r = sami_train(o);
   EXPECT_FALSE(r.stopped);
   EXPECT_EQ(r.steps, 600);
-  EXPECT_EQ(lines(dir / "progress.csv"), 1 + 1 + 100 / 25);  // the stop's row kept, then 4 more
+  EXPECT_EQ(lines(dir / "logs" / "progress.csv"), 1 + 100 / 25);
   std::filesystem::remove_all(dir);
 }
 
