@@ -160,7 +160,49 @@ std::optional<Config> babybench_config(const std::string& name) {
   return spec.config.empty() ? default_config() : load_config(spec.config);
 }
 
-TrainResult train(const Config& config, const TrainOptions& options) {
+namespace {
+
+// One run, built stage by stage: train() names the stages in order, and what a stage decides the
+// later ones read here.
+struct Run {
+  Run(const Config& c, const TrainOptions& o) : config(c), options(o), env_config(c) {}
+  const Config& config;
+  const TrainOptions& options;
+  // check_options: the run's settings (a resumed run's from its checkpoint).
+  bool by_id = false;  // an env id of any family but BabyBench's configs
+  std::string env_id;
+  std::string algorithm;
+  std::map<std::string, std::string> hyperparameters;
+  RunState resumed;
+  GradSync* sync = nullptr;  // a data-parallel run's ranks
+  int rank = 0;
+  std::optional<CurriculumSpec> curriculum_spec;
+  fs::path dir, checkpoints, latest;
+  // open_run_folder: where this rank's envs log (the config's folder on rank 0).
+  Config env_config;
+  fs::path log_file;
+  long kept_episodes = -1;
+  // make_curriculum
+  std::shared_ptr<teach::TeacherController> curriculum;
+  EnvWrapper wrap;
+  std::optional<JsonlWriter> teacher_log;
+  // make_vector
+  TrainingVector training;
+  std::unique_ptr<intrinsic::Composite> reward;
+  // make_learner: the behaviour scores of the episodes ended since the last progress row.
+  double score_sum = 0;
+  int score_count = 0;
+  std::unique_ptr<Learner> learner;
+  // open_logs: progress.csv's columns (the learner's own report keys last) and rows so far.
+  std::vector<std::string> extra;
+  fs::path csv_file;
+  std::ofstream csv;
+  std::vector<std::vector<double>> rows;
+};
+
+// Every option checked and the run's settings resolved; nothing is written before this.
+void check_options(Run& run) {
+  const TrainOptions& options = run.options;
   if (options.steps < 1) throw UserError("--steps must be at least 1");
   if (options.envs < 1) throw UserError("--envs must be at least 1");
   if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
@@ -174,55 +216,53 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   }
   // An env by id (any family but BabyBench's configs, which train as configs) has none of
   // BabyBench's extras: no training log, start randomisation or final evaluation.
-  const bool by_id = !options.env.empty();
-  const std::string env_id = by_id ? registered_env_id(options.env) : "";
-  if (by_id) {
-    if (envs::env_spec(env_id).family == "babybench")
+  run.by_id = !options.env.empty();
+  run.env_id = run.by_id ? registered_env_id(options.env) : "";
+  if (run.by_id) {
+    if (envs::env_spec(run.env_id).family == "babybench")
       throw UserError("--env " + options.env + " is a BabyBench config: train it as --config " +
                       "(cradle train --env does that for you)");
     if (options.randomize_start || options.compare_random)
       throw UserError(
           "--randomize-start and --compare-random are for BabyBench configs, not --env");
   }
-  const fs::path dir = config.save_dir;
-  const fs::path checkpoints = dir / "checkpoints";
-  const fs::path latest = checkpoints / "latest.ckpt";
-  if (options.resume && !fs::exists(latest)) {
-    throw UserError("--resume: no checkpoint at '" + latest.string() + "'");
+  run.dir = run.config.save_dir;
+  run.checkpoints = run.dir / "checkpoints";
+  run.latest = run.checkpoints / "latest.ckpt";
+  if (options.resume && !fs::exists(run.latest)) {
+    throw UserError("--resume: no checkpoint at '" + run.latest.string() + "'");
   }
   // A resumed run keeps its algorithm; --hp values override the checkpoint's (those that fix
   // network shapes or observation settings are then refused by load()). The logs are cut back to
   // what the checkpoint knows.
-  std::string algorithm = options.algorithm.empty() ? "ppo" : options.algorithm;
-  std::map<std::string, std::string> hyperparameters = options.hyperparameters;
-  RunState resumed;
+  run.algorithm = options.algorithm.empty() ? "ppo" : options.algorithm;
+  run.hyperparameters = options.hyperparameters;
   if (options.resume) {
-    const CheckpointInfo info = read_checkpoint_info(latest);
+    const CheckpointInfo info = read_checkpoint_info(run.latest);
     if (!options.algorithm.empty() && options.algorithm != info.algorithm) {
       throw UserError("--resume: the checkpoint is " + info.algorithm + ", not --algo " +
                       options.algorithm + " (leave --algo out to continue it)");
     }
-    algorithm = info.algorithm;
-    hyperparameters = parse_hyperparameter_text(info.config);
-    for (const auto& [name, value] : options.hyperparameters) hyperparameters[name] = value;
-    resumed = load_run_state(latest, nullptr);
+    run.algorithm = info.algorithm;
+    run.hyperparameters = parse_hyperparameter_text(info.config);
+    for (const auto& [name, value] : options.hyperparameters) run.hyperparameters[name] = value;
+    run.resumed = load_run_state(run.latest, nullptr);
     // The rewards are part of the task being learned: a resumed run keeps them.
     const std::string wanted =
         options.intrinsic.empty() ? "" : intrinsic::parse_intrinsic(options.intrinsic)->describe();
-    if (resumed.intrinsic && *resumed.intrinsic != wanted) {
+    if (run.resumed.intrinsic && *run.resumed.intrinsic != wanted) {
       throw UserError("--resume: the checkpoint was trained with --intrinsic '" +
-                      *resumed.intrinsic + "', not '" + wanted + "' (give --intrinsic '" +
-                      *resumed.intrinsic + "' to continue it)");
+                      *run.resumed.intrinsic + "', not '" + wanted + "' (give --intrinsic '" +
+                      *run.resumed.intrinsic + "' to continue it)");
     }
   }
-  // Data-parallel: rank r seeds with seed + r; ranks above 0 log their envs in a folder of their
-  // own (continued as they are on resume: the checkpoint counts rank 0's episodes).
-  GradSync* sync = distributed(options.sync.get()) ? options.sync.get() : nullptr;
-  const int rank = sync ? sync->rank() : 0;
-  if (sync && !learn::algorithm_traits(algorithm).data_parallel) {
+  // Data-parallel: rank r seeds with seed + r.
+  run.sync = distributed(options.sync.get()) ? options.sync.get() : nullptr;
+  run.rank = run.sync ? run.sync->rank() : 0;
+  if (run.sync && !learn::algorithm_traits(run.algorithm).data_parallel) {
     throw UserError("--distributed trains " +
                     learn::algorithms_with(&learn::AlgorithmTraits::data_parallel) + ", not " +
-                    algorithm);
+                    run.algorithm);
   }
   // Async collection is the on-policy collector's (docs/async.md).
   if (options.async_batch != 0) {
@@ -231,219 +271,248 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                       " must be between 1 and --envs - 1 (" + std::to_string(options.envs - 1) +
                       "): a batch is part of the envs");
     }
-    if (!learn::algorithm_traits(algorithm).async_collection) {
+    if (!learn::algorithm_traits(run.algorithm).async_collection) {
       throw UserError("--async-batch is for " +
                       learn::algorithms_with(&learn::AlgorithmTraits::async_collection, "and") +
-                      " (their rollout collector), not " + algorithm);
+                      " (their rollout collector), not " + run.algorithm);
     }
-    if (sync) throw UserError("--async-batch is not available with --distributed");
+    if (run.sync) throw UserError("--async-batch is not available with --distributed");
   }
-  if (sync) {
-    std::string hp_text;
-    for (const auto& [name, value] : hyperparameters) hp_text += name + "=" + value + ";";
-    check_same_command(
-        *sync, {{"--envs", options.envs},
-                {"--steps", static_cast<double>(options.steps)},
-                {"--checkpoint-every", static_cast<double>(options.checkpoint_every)},
-                {"--algo", static_cast<double>(std::hash<std::string>{}(algorithm) % (1L << 40))},
-                {"--hp", static_cast<double>(std::hash<std::string>{}(hp_text) % (1L << 40))},
-                {"--resume", options.resume ? 1.0 : 0.0},
-                {"the checkpoint's step", static_cast<double>(resumed.steps)}});
-  }
-  // A folder that holds a run (a checkpoint, or progress rows) is never replaced silently:
-  // --resume continues it, --overwrite replaces it (its checkpoints, logs and plots go first),
-  // anything else is refused. Checked after the options, before anything is written.
-  if (!options.resume) {
-    std::error_code ec;
-    const fs::path progress = dir / "logs" / "progress.csv";
-    const bool holds_run = fs::exists(latest, ec) || has_rows(progress);
-    if (holds_run && !options.overwrite) {
-      throw UserError("'" + dir.string() + "' holds a run (" +
-                      (fs::exists(latest, ec) ? latest : progress).string() +
-                      "): give --resume to continue it, --overwrite to replace it, or another "
-                      "--save-dir");
-    }
-    if (holds_run && rank == 0) {
-      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
-        fs::remove_all(dir / sub, ec);
-        if (ec) throw UserError("--overwrite: cannot remove '" + (dir / sub).string() + "'");
-      }
-    }
-  }
-  Config env_config = config;
-  if (rank > 0) env_config.save_dir = (dir / "ranks" / std::to_string(rank)).string();
-  const fs::path log_file = fs::path(env_config.save_dir) / "logs" / "training.jsonl";
-  const long kept_episodes =
-      options.resume && !by_id
-          ? cut_training_log(log_file,
-                             rank == 0 ? resumed.episodes : std::numeric_limits<long>::max())
-          : -1;
-
-  // A curriculum wraps every env: the teacher sets its reset options before each reset.
-  const fs::path teacher_file = fs::path(env_config.save_dir) / "logs" / "teacher.jsonl";
-  std::shared_ptr<teach::TeacherController> curriculum;
-  EnvWrapper wrap;
-  if ((!options.teacher.empty() || options.teacher_factory) && options.task_space.empty())
+  // A curriculum: the task space and its teacher (a teacher given by the run needs none named in
+  // the file).
+  const bool own_teacher = !options.teacher.empty() || options.teacher_factory;
+  if (own_teacher && options.task_space.empty())
     throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
   if (!options.teacher.empty() && options.teacher_factory)
     throw UserError("a teacher name and a teacher object: give one of them");
   if (!options.task_space.empty()) {
-    // A teacher given by the run needs none named in the file.
-    const bool own = !options.teacher.empty() || options.teacher_factory;
-    CurriculumSpec spec = load_task_space(options.task_space, /*need_teacher=*/!own);
-    if (!options.teacher.empty()) spec.teacher = options.teacher;
-    const std::uint64_t teacher_seed = options.seed + rank;  // a teacher per rank
-    curriculum = options.teacher_factory
-                     ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed),
-                                       teacher_seed)
-                     : make_controller(spec, teacher_seed);
-    if (options.resume && fs::exists(teacher_file))
-      replay_teacher_book(*curriculum, teacher_file, /*periodical=*/false);
-    wrap = [curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
-      return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
-    };
+    run.curriculum_spec = load_task_space(options.task_space, /*need_teacher=*/!own_teacher);
+    if (!options.teacher.empty()) run.curriculum_spec->teacher = options.teacher;
   }
-  std::optional<JsonlWriter> teacher_log;
-  if (curriculum) teacher_log.emplace(teacher_file, options.resume);
-  auto write_teacher_log = [&](bool dump) {
-    if (!teacher_log) return;
-    for (const teach::EpisodeRecord& e : curriculum->take_episodes())
-      teacher_log->write(teach::train_line(e));
-    if (dump)
-      teacher_log->write(teach::dump_line(curriculum->env_steps(), curriculum->teacher_dump()));
-    teacher_log->flush();
+  if (run.sync) {
+    std::string hp_text;
+    for (const auto& [name, value] : run.hyperparameters) hp_text += name + "=" + value + ";";
+    check_same_command(
+        *run.sync,
+        {{"--envs", options.envs},
+         {"--steps", static_cast<double>(options.steps)},
+         {"--checkpoint-every", static_cast<double>(options.checkpoint_every)},
+         {"--algo", static_cast<double>(std::hash<std::string>{}(run.algorithm) % (1L << 40))},
+         {"--hp", static_cast<double>(std::hash<std::string>{}(hp_text) % (1L << 40))},
+         {"--resume", options.resume ? 1.0 : 0.0},
+         {"the checkpoint's step", static_cast<double>(run.resumed.steps)}});
+  }
+}
+
+// The run folder: one that holds a run (a checkpoint, or progress rows) is never replaced
+// silently: --resume continues it, --overwrite replaces it (its checkpoints, logs and plots go
+// first), anything else is refused. A resumed BabyBench run's training log is cut back to the
+// checkpoint's episodes. Ranks above 0 log their envs in a folder of their own (continued as
+// they are on resume: the checkpoint counts rank 0's episodes).
+void open_run_folder(Run& run) {
+  const TrainOptions& options = run.options;
+  if (!options.resume) {
+    std::error_code ec;
+    const fs::path progress = run.dir / "logs" / "progress.csv";
+    const bool holds_run = fs::exists(run.latest, ec) || has_rows(progress);
+    if (holds_run && !options.overwrite) {
+      throw UserError("'" + run.dir.string() + "' holds a run (" +
+                      (fs::exists(run.latest, ec) ? run.latest : progress).string() +
+                      "): give --resume to continue it, --overwrite to replace it, or another "
+                      "--save-dir");
+    }
+    if (holds_run && run.rank == 0) {
+      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
+        fs::remove_all(run.dir / sub, ec);
+        if (ec) throw UserError("--overwrite: cannot remove '" + (run.dir / sub).string() + "'");
+      }
+    }
+  }
+  if (run.rank > 0)
+    run.env_config.save_dir = (run.dir / "ranks" / std::to_string(run.rank)).string();
+  run.log_file = fs::path(run.env_config.save_dir) / "logs" / "training.jsonl";
+  if (options.resume && !run.by_id) {
+    run.kept_episodes = cut_training_log(
+        run.log_file, run.rank == 0 ? run.resumed.episodes : std::numeric_limits<long>::max());
+  }
+}
+
+// With a task space, the teacher's controller (one per rank), the wrapper through which it sets
+// every env's reset options, and its book, logs/teacher.jsonl (replayed into a resumed teacher).
+void make_curriculum(Run& run) {
+  if (!run.curriculum_spec) return;
+  const TrainOptions& options = run.options;
+  const fs::path teacher_file = fs::path(run.env_config.save_dir) / "logs" / "teacher.jsonl";
+  const std::uint64_t teacher_seed = options.seed + run.rank;
+  const CurriculumSpec& spec = *run.curriculum_spec;
+  run.curriculum =
+      options.teacher_factory
+          ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed)
+          : make_controller(spec, teacher_seed);
+  if (options.resume && fs::exists(teacher_file))
+    replay_teacher_book(*run.curriculum, teacher_file, /*periodical=*/false);
+  run.wrap = [curriculum = run.curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
+    return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
   };
-  // A resumed run's first resets end no episode of this run's log.
-  if (by_id) {
-    for (const fs::path& logs : {dir / "logs", fs::path(env_config.save_dir) / "logs"}) {
+  run.teacher_log.emplace(teacher_file, options.resume);
+}
+
+// The teacher's new episodes (and with `dump` its state) to logs/teacher.jsonl.
+void write_teacher_log(Run& run, bool dump) {
+  if (!run.teacher_log) return;
+  for (const teach::EpisodeRecord& e : run.curriculum->take_episodes())
+    run.teacher_log->write(teach::train_line(e));
+  if (dump)
+    run.teacher_log->write(
+        teach::dump_line(run.curriculum->env_steps(), run.curriculum->teacher_dump()));
+  run.teacher_log->flush();
+}
+
+// The vector of envs (threads, worker processes or async batches) and the intrinsic rewards
+// bound to its observations.
+void make_vector(Run& run) {
+  const TrainOptions& options = run.options;
+  if (run.by_id) {
+    for (const fs::path& logs : {run.dir / "logs", fs::path(run.env_config.save_dir) / "logs"}) {
       make_folder(logs, "cannot create");
     }
   }
-  TrainingVector training =
-      by_id
-          ? make_env_training(env_id, options.envs, options.threads, options.seed + rank, wrap,
-                              options.async_batch, {}, options.procs)
-          : make_babybench_training(env_config, options.envs, options.threads, options.seed + rank,
-                                    kept_episodes, wrap, options.async_batch, options.procs);
-  std::unique_ptr<VecEnv>& vec = training.vec;
-  for (int i = 0; i < vec->num_envs() && options.randomize_start; ++i) {
-    vec->env(i).set_reset_options({{"randomize_start", 1}});
+  run.training = run.by_id ? make_env_training(run.env_id, options.envs, options.threads,
+                                               options.seed + run.rank, run.wrap,
+                                               options.async_batch, {}, options.procs)
+                           : make_babybench_training(run.env_config, options.envs, options.threads,
+                                                     options.seed + run.rank, run.kept_episodes,
+                                                     run.wrap, options.async_batch, options.procs);
+  VecEnv& vec = *run.training.vec;
+  for (int i = 0; i < vec.num_envs() && options.randomize_start; ++i) {
+    vec.env(i).set_reset_options({{"randomize_start", 1}});
   }
-  const std::shared_ptr<envs::TrainingLog>& training_log = training.log;
-  std::unique_ptr<intrinsic::Composite> reward;
   if (!options.intrinsic.empty()) {
-    reward = intrinsic::parse_intrinsic(options.intrinsic);
-    reward->bind(*vec);
+    run.reward = intrinsic::parse_intrinsic(options.intrinsic);
+    run.reward->bind(vec);
     // Every learn() resets the vector: no transition spans that reset.
-    set_after_reset(*vec, [&reward, &vec] { reward->reset(*vec); });
+    set_after_reset(vec, [&run] { run.reward->reset(*run.training.vec); });
   }
+}
 
-  // Behaviour score of the episodes that end, seen at the step that ends them (async: the batch,
-  // whose slot i is env env_id(i)).
-  double score_sum = 0;
-  int score_count = 0;
-  LearnerOptions lo{.seed = options.seed + rank, .hyperparameters = hyperparameters};
+// The learner, fresh or resumed from latest.ckpt. Its reward hook adds the intrinsic rewards
+// and the caller's terms, and tallies the behaviour score of each episode that ends (async: the
+// batch, whose slot i is env env_id(i)).
+void make_learner(Run& run) {
+  const TrainOptions& options = run.options;
+  LearnerOptions lo{.seed = options.seed + run.rank, .hyperparameters = run.hyperparameters};
   lo.sync = options.sync;
   lo.update_threads = options.update_threads;
-  lo.reward_hook = [&](const VecEnv& env, std::span<const double> actions,
-                       std::span<double> rewards) {
-    if (reward) reward->compute(env, actions, rewards);
-    if (options.reward_hook) options.reward_hook(env, actions, rewards);
+  lo.reward_hook = [&run](const VecEnv& env, std::span<const double> actions,
+                          std::span<double> rewards) {
+    if (run.reward) run.reward->compute(env, actions, rewards);
+    if (run.options.reward_hook) run.options.reward_hook(env, actions, rewards);
     for (int i = 0; i < env.num_envs(); ++i) {
       if (env.terminated()[i] || env.truncated()[i]) {
         const double s = env.env(i).score();
         if (!std::isnan(s)) {
-          score_sum += s;
-          ++score_count;
+          run.score_sum += s;
+          ++run.score_count;
         }
       }
     }
   };
-  std::unique_ptr<Learner> learner = learn::make_learner(algorithm, *vec, lo);
+  run.learner = learn::make_learner(run.algorithm, *run.training.vec, lo);
   // SPDL values its tasks with the student's value function.
-  if (curriculum)
-    curriculum->teacher().set_value_estimator(learner_value_estimator(
-        [&learner]() -> Learner& { return *learner; }, vec->observation_space()));
+  if (run.curriculum)
+    run.curriculum->teacher().set_value_estimator(learner_value_estimator(
+        [&run]() -> Learner& { return *run.learner; }, run.training.vec->observation_space()));
   if (options.resume) {
-    learner->load(latest);
-    load_run_state(latest, reward.get());
+    run.learner->load(run.latest);
+    load_run_state(run.latest, run.reward.get());
   }
+}
 
+// run.json (what this run is: a fresh run writes it, a resumed one keeps it) and
+// logs/progress.csv, continued on resume and cut back to the checkpoint's step (later rows and a
+// torn line kept aside; another version's file kept beside a new one). Rank 0 writes them.
+void open_logs(Run& run) {
+  const TrainOptions& options = run.options;
   std::error_code ec;
-  fs::create_directories(checkpoints, ec);
-  // A checkpoint is an episode boundary: every env's episode is recorded (cut short) and the log
-  // flushed, so the checkpoint's episode count is the log's, and the next learn() starts fresh
-  // episodes exactly as a resumed run does.
-  auto save_checkpoint = [&](const std::vector<fs::path>& files) {
-    training.end_episodes();
-    if (training_log) training_log->flush();
-    const RunState run{.steps = learner->steps(),
-                       .episodes = training_log ? training_log->episodes() : 0,
-                       .intrinsic = reward ? reward->describe() : ""};
-    if (rank > 0) return;  // rank 0 writes the run's checkpoints
-    for (const fs::path& file : files) save_run_checkpoint(file, *learner, reward.get(), run);
-  };
-
-  // progress.csv: continued on resume, cut back to the checkpoint's step (later rows and a torn
-  // line kept aside); another version's file is kept beside a new one.
-  // run.json: what this run is (a fresh run writes it; a resumed one keeps it).
-  if (rank == 0 && !options.resume) {
-    nlohmann::ordered_json run = {{"cradle_version", CRADLE_VERSION},
-                                  {"env", by_id ? env_id : "babybench config"},
-                                  {"family", by_id ? envs::env_spec(env_id).family : "babybench"},
-                                  {"algorithm", algorithm},
-                                  {"seed", options.seed},
-                                  {"steps", options.steps},
-                                  {"envs", options.envs},
-                                  {"checkpoint_every", options.checkpoint_every},
-                                  {"intrinsic", reward ? reward->describe() : ""},
-                                  {"hyperparameters", hyperparameters},
-                                  {"task_space", options.task_space},
-                                  {"teacher", options.teacher},
-                                  {"world_size", sync ? sync->world_size() : 1}};
-    if (!by_id) run["config"] = to_json(config);
-    write_atomically(dir / "run.json", run.dump(2) + "\n");
+  fs::create_directories(run.checkpoints, ec);
+  if (run.rank == 0 && !options.resume) {
+    nlohmann::ordered_json json = {
+        {"cradle_version", CRADLE_VERSION},
+        {"env", run.by_id ? run.env_id : "babybench config"},
+        {"family", run.by_id ? envs::env_spec(run.env_id).family : "babybench"},
+        {"algorithm", run.algorithm},
+        {"seed", options.seed},
+        {"steps", options.steps},
+        {"envs", options.envs},
+        {"checkpoint_every", options.checkpoint_every},
+        {"intrinsic", run.reward ? run.reward->describe() : ""},
+        {"hyperparameters", run.hyperparameters},
+        {"task_space", options.task_space},
+        {"teacher", options.teacher},
+        {"world_size", run.sync ? run.sync->world_size() : 1}};
+    if (!run.by_id) json["config"] = to_json(run.config);
+    write_atomically(run.dir / "run.json", json.dump(2) + "\n");
   }
-  const fs::path csv_file = dir / "logs" / "progress.csv";
-  std::string header;
+  run.csv_file = run.dir / "logs" / "progress.csv";
   // The learner's own report keys follow the common columns (SaMI's: its SaNCE loss and weight).
   std::vector<std::string> columns(std::begin(kColumns), std::end(kColumns));
-  const std::vector<std::string> extra = extra_report_keys(algorithm);
-  for (const std::string& key : extra) columns.push_back("losses/" + key);
+  run.extra = extra_report_keys(run.algorithm);
+  for (const std::string& key : run.extra) columns.push_back("losses/" + key);
+  std::string header;
   for (size_t c = 0; c < columns.size(); ++c) header += (c ? "," : "") + columns[c];
   ProgressCut cut;
-  if (options.resume && rank == 0) cut = cut_progress(csv_file, header, resumed.steps);
+  if (options.resume && run.rank == 0) cut = cut_progress(run.csv_file, header, run.resumed.steps);
   if (!cut.kept_aside.empty())
     std::cerr << "progress.csv rows kept aside in " << cut.kept_aside.string() << "\n";
-  // Rank 0 writes progress.csv; the others' stream writes nowhere.
-  std::ofstream csv;
-  if (rank == 0) csv.open(csv_file, cut.append ? std::ios::app : std::ios::trunc);
-  if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
-  if (!cut.append) csv << header << "\n";
-  std::vector<std::vector<double>> rows = std::move(cut.rows);
-  for (auto& row : rows) row.resize(columns.size(), std::nan(""));
+  // The other ranks' stream writes nowhere.
+  if (run.rank == 0) run.csv.open(run.csv_file, cut.append ? std::ios::app : std::ios::trunc);
+  if (run.rank == 0 && !run.csv) throw UserError("cannot write '" + run.csv_file.string() + "'");
+  if (!cut.append) run.csv << header << "\n";
+  run.rows = std::move(cut.rows);
+  for (auto& row : run.rows) row.resize(columns.size(), std::nan(""));
+}
 
+// A checkpoint is an episode boundary: every env's episode is recorded (cut short) and the log
+// flushed, so the checkpoint's episode count is the log's, and the next learn() starts fresh
+// episodes exactly as a resumed run does. Rank 0 writes the run's checkpoints.
+void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
+  run.training.end_episodes();
+  if (run.training.log) run.training.log->flush();
+  const RunState state{.steps = run.learner->steps(),
+                       .episodes = run.training.log ? run.training.log->episodes() : 0,
+                       .intrinsic = run.reward ? run.reward->describe() : ""};
+  if (run.rank > 0) return;
+  for (const fs::path& file : files)
+    save_run_checkpoint(file, *run.learner, run.reward.get(), state);
+}
+
+// The loop: a progress row (and the teacher's book) at every report, a checkpoint every
+// checkpoint_every steps, learning stopped at each checkpoint and continued in a new learn()
+// call. Returns the next checkpoint's step.
+long train_loop(Run& run, TrainResult& result) {
+  const TrainOptions& options = run.options;
   const auto start = Clock::now();
-  const long first_step = learner->steps();
-  const ProgressBar bar(options.steps, first_step, options.progress_bar && rank == 0);
+  const long first_step = run.learner->steps();
+  const ProgressBar bar(options.steps, first_step, options.progress_bar && run.rank == 0);
   double last_score = std::nan("");
   // Stopping (Ctrl-C) is agreed by every rank of a data-parallel run.
   bool stopped = false;
-  auto stopping = [&] { return sync ? stopped : options.stop && options.stop->load(); };
+  auto stopping = [&] { return run.sync ? stopped : options.stop && options.stop->load(); };
   auto on_progress = [&](const TrainStats& local) {
     TrainStats s = local;
-    if (sync) {
-      stopped =
-          pool_progress(*sync, s, score_sum, score_count, options.stop && options.stop->load());
+    if (run.sync) {
+      stopped = pool_progress(*run.sync, s, run.score_sum, run.score_count,
+                              options.stop && options.stop->load());
     }
-    check_finite_losses(s, latest);
-    write_teacher_log(false);
-    if (reward) reward->update();
+    check_finite_losses(s, run.latest);
+    write_teacher_log(run, false);
+    if (run.reward) run.reward->update();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (score_count > 0) last_score = score_sum / score_count;
-    const double window_score = score_count > 0 ? score_sum / score_count : std::nan("");
-    score_sum = 0;
-    score_count = 0;
+    if (run.score_count > 0) last_score = run.score_sum / run.score_count;
+    const double window_score =
+        run.score_count > 0 ? run.score_sum / run.score_count : std::nan("");
+    run.score_sum = 0;
+    run.score_count = 0;
     std::vector<double> row = {static_cast<double>(s.steps),
                                elapsed,
                                s.sps,
@@ -464,70 +533,78 @@ TrainResult train(const Config& config, const TrainOptions& options) {
                                loss(s, "qf1_values"),
                                loss(s, "collect_seconds"),
                                loss(s, "update_seconds")};
-    for (const std::string& key : extra) row.push_back(loss(s, key.c_str()));
-    for (size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << csv_cell(row[c]);
-    csv << "\n";
-    csv.flush();
-    if (rank == 0 && !csv) throw UserError("cannot write '" + csv_file.string() + "'");
-    rows.push_back(std::move(row));
+    for (const std::string& key : run.extra) row.push_back(loss(s, key.c_str()));
+    for (size_t c = 0; c < row.size(); ++c) run.csv << (c ? "," : "") << csv_cell(row[c]);
+    run.csv << "\n";
+    run.csv.flush();
+    if (run.rank == 0 && !run.csv) throw UserError("cannot write '" + run.csv_file.string() + "'");
+    run.rows.push_back(std::move(row));
     if (options.on_report) options.on_report(s);
 
     // Only BabyBench scores behaviour.
-    bar.show(
-        s.steps, elapsed,
-        "return " + csv_cell(s.episodic_return) + (by_id ? "" : "  score " + csv_cell(last_score)));
+    bar.show(s.steps, elapsed,
+             "return " + csv_cell(s.episodic_return) +
+                 (run.by_id ? "" : "  score " + csv_cell(last_score)));
     return true;
   };
-  // Learning stops at each checkpoint (an episode boundary) and continues in a new learn() call.
   const long next_checkpoint = run_loop(
-      *learner,
+      *run.learner,
       {.total_steps = options.steps,
        .boundary_every = options.checkpoint_every,
        .report = on_progress,
        .at_boundary =
            [&] {
              save_checkpoint(
-                 {checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"), latest});
+                 run, {run.checkpoints / ("step_" + std::to_string(run.learner->steps()) + ".ckpt"),
+                       run.latest});
            },
        .stopping = stopping});
   bar.finish();
-
-  TrainResult result;
-  result.steps = learner->steps();
+  result.steps = run.learner->steps();
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.steps_per_second = (result.steps - first_step) / std::max(result.seconds, 1e-9);
-  result.checkpoint = checkpoints / "final.ckpt";
-  std::vector<fs::path> files = {latest, result.checkpoint};
-  if (learner->steps() >= next_checkpoint) {
-    files.push_back(checkpoints / ("step_" + std::to_string(learner->steps()) + ".ckpt"));
+  return next_checkpoint;
+}
+
+// The end: the final checkpoint and the teacher's state, the ranks' networks compared, then (rank
+// 0) the learning curves, the training log's score and the trained policy's evaluation.
+void finish(Run& run, long next_checkpoint, TrainResult& result) {
+  const TrainOptions& options = run.options;
+  result.checkpoint = run.checkpoints / "final.ckpt";
+  std::vector<fs::path> files = {run.latest, result.checkpoint};
+  if (run.learner->steps() >= next_checkpoint) {
+    files.push_back(run.checkpoints / ("step_" + std::to_string(run.learner->steps()) + ".ckpt"));
   }
-  save_checkpoint(files);
-  write_teacher_log(true);
-  for (int i = 0; i < vec->num_envs(); ++i) vec->env(i).close();
-  result.parameter_hash = learner->parameter_hash();
+  save_checkpoint(run, files);
+  write_teacher_log(run, true);
+  VecEnv& vec = *run.training.vec;
+  for (int i = 0; i < vec.num_envs(); ++i) vec.env(i).close();
+  result.parameter_hash = run.learner->parameter_hash();
   // Data-parallel: every rank must end with the same networks.
   const std::uint64_t hash = result.parameter_hash;
-  if (sync && !first_difference(*sync, {{"high", static_cast<double>(hash >> 32)},
-                                        {"low", static_cast<double>(hash & 0xffffffffULL)}})
-                   .empty()) {
+  if (run.sync && !first_difference(*run.sync, {{"high", static_cast<double>(hash >> 32)},
+                                                {"low", static_cast<double>(hash & 0xffffffffULL)}})
+                       .empty()) {
     throw UserError(
         "the ranks' parameters differ after training (a learner broke the "
         "data-parallel contract)");
   }
-  if (rank > 0) return result;  // rank 0 draws, scores and evaluates the run
-  if (!rows.empty()) plot_curves(rows, dir / "plots");
+  if (run.rank > 0) return;  // rank 0 draws, scores and evaluates the run
+  if (!run.rows.empty()) plot_curves(run.rows, run.dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
-  if (!by_id && fs::exists(log_file))
+  if (!run.by_id && fs::exists(run.log_file))
     result.training_score = eval::training_score(
-        config.behavior, eval::read_training_log(log_file, config.behavior, training.geom_count));
-
+        run.config.behavior,
+        eval::read_training_log(run.log_file, run.config.behavior, run.training.geom_count));
+  const bool stopped = options.stop && options.stop->load();
+  if (options.eval_episodes <= 0 || stopped) return;
+  Learner* l = run.learner.get();
   // A run by id: the trained policy's whole episodes on a fresh env, acting deterministically
   // from seeds apart from training's (evaluation.json).
-  if (by_id && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
-    std::unique_ptr<envs::Env> env = envs::make_env(env_id, options.seed + 1000);
+  if (run.by_id) {
+    std::unique_ptr<envs::Env> env = envs::make_env(run.env_id, options.seed + 1000);
     std::vector<std::uint64_t> seeds;
     for (int k = 0; k < options.eval_episodes; ++k) seeds.push_back(options.seed + 1000 + k);
-    Learner* l = learner.get();
     result.episodes = run_episodes(
         *env,
         {.act = [l](const envs::ObservationBuffers& obs,
@@ -535,34 +612,46 @@ TrainResult train(const Config& config, const TrainOptions& options) {
          .new_episode = [l] { l->new_episode(); }},
         seeds);
     env->close();
-    nlohmann::ordered_json report = {{"env", env_id},
-                                     {"algorithm", algorithm},
-                                     {"steps", learner->steps()},
+    nlohmann::ordered_json report = {{"env", run.env_id},
+                                     {"algorithm", run.algorithm},
+                                     {"steps", l->steps()},
                                      {"policy_actions", "mean"}};
     report.update(episodes_json(result.episodes));
-    write_atomically(dir / "evaluation.json", report.dump(2) + "\n");
+    write_atomically(run.dir / "evaluation.json", report.dump(2) + "\n");
+    return;
   }
+  // A BabyBench config: the trained policy's evaluation, acting deterministically.
+  train::EvaluationOptions eo{.episodes = options.eval_episodes,
+                              .duration = options.eval_duration,
+                              .render = options.eval_render,
+                              .seed = options.seed + 1000,
+                              .quiet = true,
+                              .policy_actions = "mean"};
+  result.evaluation =
+      train::evaluate(run.config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
+        l->act(env.observation(), action, /*deterministic=*/true);
+      });
+  if (options.compare_random) {
+    Config baseline = run.config;
+    baseline.save_dir = (run.dir / "random_baseline").string();
+    eo.render = false;
+    result.random_evaluation = train::evaluate(baseline, eo);
+  }
+}
 
-  // The trained policy's evaluation, acting deterministically.
-  if (!by_id && options.eval_episodes > 0 && !(options.stop && options.stop->load())) {
-    train::EvaluationOptions eo{.episodes = options.eval_episodes,
-                                .duration = options.eval_duration,
-                                .render = options.eval_render,
-                                .seed = options.seed + 1000,
-                                .quiet = true,
-                                .policy_actions = "mean"};
-    Learner* l = learner.get();
-    result.evaluation =
-        train::evaluate(config, eo, [l](const envs::BabyBenchEnv& env, std::span<double> action) {
-          l->act(env.observation(), action, /*deterministic=*/true);
-        });
-    if (options.compare_random) {
-      Config baseline = config;
-      baseline.save_dir = (dir / "random_baseline").string();
-      eo.render = false;
-      result.random_evaluation = train::evaluate(baseline, eo);
-    }
-  }
+}  // namespace
+
+TrainResult train(const Config& config, const TrainOptions& options) {
+  Run run(config, options);
+  check_options(run);
+  open_run_folder(run);
+  make_curriculum(run);
+  make_vector(run);
+  make_learner(run);
+  open_logs(run);
+  TrainResult result;
+  const long next_checkpoint = train_loop(run, result);
+  finish(run, next_checkpoint, result);
   return result;
 }
 

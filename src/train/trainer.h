@@ -1,7 +1,15 @@
-// `cradle train`: a BabyBench config trained with one learner and intrinsic rewards on a vector
-// of envs. Writes the env training log, logs/progress.csv (CleanRL names), checkpoints
-// (checkpoints/step_<n>.ckpt, latest.ckpt) and, at the end, the evaluation of the trained policy
-// and learning-curve PNGs.
+// `cradle train`, the run path of every env family: a BabyBench config or any registered env id
+// trained with one learner (and intrinsic rewards, a curriculum, data-parallel ranks) on a vector
+// of envs; `cradle sami train` is a front end over it. train() runs its stages in order:
+//   check_options    every option, the resumed checkpoint's settings (nothing written before)
+//   open_run_folder  a held run refused or replaced; a resumed training log cut back
+//   make_curriculum  with a task space: the teacher's controller, env wrapper and book
+//   make_vector      the envs (threads, processes or async batches) and intrinsic rewards
+//   make_learner     fresh or resumed from checkpoints/latest.ckpt
+//   open_logs        run.json, logs/progress.csv (CleanRL names; cut back on resume)
+//   train_loop       a progress row per report, checkpoints/step_<n>.ckpt and latest.ckpt
+//   finish           final.ckpt, the ranks' agreement, plots, the trained policy's evaluation
+// BabyBench configs also write the env training log and evaluate as BabyBench does.
 #pragma once
 
 #include <atomic>
