@@ -197,6 +197,16 @@ TEST(CliVocabulary, EveryTrainingCommandSpeaksTheSameFlags) {
       (dir / "train").string());
   ASSERT_EQ(train.status, 0) << train.out;
   EXPECT_TRUE(fs::exists(dir / "train" / "checkpoints" / "final.ckpt"));
+  // A bad curriculum flag is refused before --overwrite removes the run.
+  const std::vector<std::string> bad_flags = {"--teacher ALP-GMM",
+                                              "--task-space " + (dir / "none.yml").string()};
+  for (const std::string& bad : bad_flags) {
+    const auto refused =
+        run_cradle("train --env mimo/reach --steps 128 --no-progress --overwrite " + bad +
+                   " --out " + (dir / "train").string());
+    EXPECT_EQ(refused.status, 1) << bad << "\n" << refused.out;
+    EXPECT_TRUE(fs::exists(dir / "train" / "checkpoints" / "final.ckpt")) << bad;
+  }
   fs::remove_all(dir);
 }
 
