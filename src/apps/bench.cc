@@ -54,9 +54,7 @@ struct MimoHooks {
   void begin(long n) {
     const Box& space = env.action_space();
     const size_t a = width();
-    for (size_t k = 0; k < static_cast<size_t>(n) * a; ++k) {
-      actions[k] = rng.uniform(space.low[k % a], space.high[k % a]);
-    }
+    space.sample(rng, std::span<double>(actions).first(static_cast<size_t>(n) * a));
     m = env.model();
     recorder.begin(m, env.data(), bare);
     wall = std::chrono::steady_clock::now();

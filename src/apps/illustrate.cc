@@ -319,8 +319,7 @@ void run(const IllustrateOptions& o) {
     if (learner) {
       learner->act(env->observation(), action, /*deterministic=*/!o.stochastic);
     } else {
-      for (size_t k = 0; k < action.size(); ++k)
-        action[k] = rng.uniform(space.low[k], space.high[k]);
+      space.sample(rng, action);
     }
     const envs::StepResult r = env->step(action);
     current.ret += r.reward;

@@ -43,9 +43,7 @@ void register_random(CLI::App& app) {
     std::vector<double> action(space.size());
     Rng rng(opts->seed + 1);
     for (long t = 0; t < opts->train_for; ++t) {
-      for (size_t k = 0; k < action.size(); ++k) {
-        action[k] = rng.uniform(space.low[k], space.high[k]);
-      }
+      space.sample(rng, action);
       const envs::StepResult r = env->step(action);
       if (r.terminated || r.truncated) env->reset();
     }

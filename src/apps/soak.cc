@@ -135,8 +135,7 @@ void register_soak(CLI::App& app) {
       Rng rng(opts->seed + 2000 + static_cast<std::uint64_t>(evaluations));
       const train::EpisodePolicy random{
           .act = [&](const envs::ObservationBuffers&, std::span<double> action) {
-            for (size_t j = 0; j < action.size(); ++j)
-              action[j] = rng.uniform(space.low[j], space.high[j]);
+            space.sample(rng, action);
           }};
       std::vector<std::uint64_t> seeds;
       for (int e = 0; e < opts->eval_episodes; ++e) seeds.push_back(opts->seed + 1000 + e);
@@ -179,10 +178,7 @@ void register_soak(CLI::App& app) {
       long next_eval = opts->eval_every;
       long next_print = 10000;
       while (steps < opts->steps) {
-        for (size_t k = 0; k < actions.size(); ++k) {
-          const size_t j = k % space.size();
-          actions[k] = rng.uniform(space.low[j], space.high[j]);
-        }
+        space.sample(rng, actions);
         const Clock::time_point before = Clock::now();
         vec->step(actions);
         stepping += Clock::now() - before;

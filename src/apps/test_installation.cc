@@ -44,9 +44,7 @@ void register_test_installation(CLI::App& app) {
       std::vector<double> action(space.size());
       Rng rng(1);
       for (int t = 0; t < 1 + opts->steps; ++t) {
-        for (size_t k = 0; k < action.size(); ++k) {
-          action[k] = rng.uniform(space.low[k], space.high[k]);
-        }
+        space.sample(rng, action);
         env->step(action);
         composer.corner(*env, image);
         video.write(image);

@@ -1,5 +1,7 @@
 #include "core/spaces.h"
 
+#include "core/rng.h"
+
 namespace cradle {
 
 std::string_view dtype_name(DType dtype) {
@@ -37,6 +39,11 @@ Box Box::uniform(std::vector<int> shape, DType dtype, double low, double high) {
   box.low.assign(box.size(), low);
   box.high.assign(box.size(), high);
   return box;
+}
+
+void Box::sample(Rng& rng, std::span<double> out) const {
+  const size_t n = low.size();
+  for (size_t k = 0; k < out.size(); ++k) out[k] = rng.uniform(low[k % n], high[k % n]);
 }
 
 const Box* DictSpace::find(std::string_view key) const {

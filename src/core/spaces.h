@@ -4,12 +4,15 @@
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 namespace cradle {
+
+class Rng;
 
 enum class DType { kFloat32, kFloat64, kUInt8 };
 std::string_view dtype_name(DType dtype);  // "float32", "float64", "uint8"
@@ -28,6 +31,10 @@ struct Box {
     return uniform(std::move(shape), dtype, -std::numeric_limits<double>::infinity(),
                    std::numeric_limits<double>::infinity());
   }
+  // Uniform random values within the bounds (finite ones) from `rng`, element by element: `out`
+  // holds one or several boxes' worth (value k within bound k mod size()), as random actions for
+  // one env or a vector of them.
+  void sample(Rng& rng, std::span<double> out) const;
   friend bool operator==(const Box&, const Box&) = default;
 };
 

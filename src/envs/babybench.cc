@@ -256,9 +256,7 @@ void BabyBenchEnv::reset(std::optional<std::uint64_t> seed) {
   // Random start: a few random actions drawn from the env's own (seeded) generator.
   const Box& space = action_space();
   for (int i = 0; i < kRandomResetSteps; ++i) {
-    for (size_t k = 0; k < random_action_.size(); ++k) {
-      random_action_[k] = rng_.uniform(space.low[k], space.high[k]);
-    }
+    space.sample(rng_, random_action_);
     sim.step(random_action_);
   }
   steps_ = 0;

@@ -132,9 +132,7 @@ void write_trajectory(const Trajectory& traj, int steps, int nq, int nu,
 Policy random_policy(std::uint64_t seed) {
   auto rng = std::make_shared<Rng>(seed);
   return [rng](const envs::BabyBenchEnv& env, std::span<double> action) {
-    const Box& space = env.action_space();
-    for (size_t k = 0; k < action.size(); ++k)
-      action[k] = rng->uniform(space.low[k], space.high[k]);
+    env.action_space().sample(*rng, action);
   };
 }
 

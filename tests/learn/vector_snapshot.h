@@ -15,10 +15,7 @@ namespace cradle::learn::test {
 
 // Uniform random actions for every env (rows of the space's size), from `rng`.
 inline void random_actions(const Box& space, Rng& rng, std::vector<double>& actions) {
-  const size_t dim = space.low.size();
-  for (size_t j = 0; j < actions.size(); ++j) {
-    actions[j] = rng.uniform(space.low[j % dim], space.high[j % dim]);
-  }
+  space.sample(rng, actions);
 }
 
 // Rewards, flags, and for every env its observations, score and every info value (unpublished

@@ -35,9 +35,7 @@ class Reach final : public SampleTask {
     const mjModel* m = core.model();
     mjData* d = core.data();
     for (int i = 0; i < kRandomResetSteps; ++i) {
-      for (size_t k = 0; k < random_action_.size(); ++k) {
-        random_action_[k] = rng.uniform(space.low[k], space.high[k]);
-      }
+      space.sample(rng, random_action_);
       core.sim().actuation().apply(random_action_, d);
       core.sim().actuation().substep(d);
       core.raw_step();
