@@ -30,6 +30,7 @@
 #include "train/curriculum_env.h"
 #include "train/env_vector.h"
 #include "train/loop.h"
+#include "train/sami/sami_train.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -237,6 +238,13 @@ void check_options(Run& run) {
   // what the checkpoint knows.
   run.algorithm = options.algorithm.empty() ? "ppo" : options.algorithm;
   run.hyperparameters = options.hyperparameters;
+  // What the env's family trains the learner with comes under the user's values (SaMI's
+  // learners: whole episodes as trajectories, Panda's batch sizes).
+  if (run.by_id && !options.resume) {
+    const envs::EnvSpec spec = envs::env_spec(run.env_id);
+    for (const auto& [name, value] : sami_presets(spec.id, spec.max_episode_steps, run.algorithm))
+      run.hyperparameters.try_emplace(name, value);
+  }
   if (options.resume) {
     const CheckpointInfo info = read_checkpoint_info(run.latest);
     if (!options.algorithm.empty() && options.algorithm != info.algorithm) {

@@ -59,7 +59,9 @@ struct TrainOptions {
   bool overwrite = false;
   bool randomize_start = false;  // random start postures within joint limits
   long checkpoint_every = 100000;
-  std::map<std::string, std::string> hyperparameters;  // overrides, by name
+  // Overrides, by name, over the learner's defaults and what the env's family trains it with
+  // (train/sami/sami_train.h's sami_presets: SaMI's learners on an env by id).
+  std::map<std::string, std::string> hyperparameters;
   int eval_episodes = 2;                               // 0: no final evaluation
   int eval_duration = 1000;
   bool eval_render = true;

@@ -34,8 +34,10 @@
 //
 // Settings: SamiConfig (context_sac.h; defaults SaMI's MuJoCo ones, Panda's buffer_size,
 // batch_size and contrast_batch_size of 1000, 256, 256 come as hyperparameters) plus:
-//   horizon        longest trajectory stored (SaMI: the env's spec horizon; default 1000)
-//   report_every   vector steps between progress reports (default 1000)
+//   horizon        longest trajectory stored (SaMI: the env's spec horizon; default 1000;
+//                  `cradle train --env ID` presets it to the env's episode length)
+//   report_every   vector steps between progress reports (default 1000; `cradle train --env
+//                  ID`: the episode length)
 // An unknown name or a bad value is a one-line UserError.
 //
 // Checkpoints hold everything: ContextSac's networks, optimisers and generator, the rings (so a

@@ -35,12 +35,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Panda's buffer and batch sizes (tma_sami.md §6), before the user's values.
-std::map<std::string, std::string> env_defaults(sami::EnvId id) {
-  if (id != sami::EnvId::kPandaPush) return {};
-  return {{"buffer_size", "1000"}, {"batch_size", "256"}, {"contrast_batch_size", "256"}};
-}
-
 // The learner registry's name of a SaMI method ("SaCCM" -> "saccm"); UserError for another.
 std::string learner_name(const std::string& method) {
   for (const std::string_view name : learn::meta::sami_learner_names()) {
@@ -86,6 +80,23 @@ std::string cell_name(const sami::TaskSet& set, bool panda) {
 
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id) {
   return sami::one_set_per_env(sami::split_sets(id, sami::Split::kTrain));
+}
+
+std::map<std::string, std::string> sami_presets(const std::string& env_id, int max_episode_steps,
+                                                const std::string& algorithm) {
+  if (learn::meta::sami_method(algorithm).empty()) return {};
+  std::map<std::string, std::string> presets;
+  if (max_episode_steps > 0) {
+    presets["horizon"] = std::to_string(max_episode_steps);
+    presets["report_every"] = std::to_string(max_episode_steps);
+  }
+  // Panda's config (tma_sami.md §6).
+  if (env_id.starts_with("sami/PandaPush:")) {
+    presets["buffer_size"] = "1000";
+    presets["batch_size"] = "256";
+    presets["contrast_batch_size"] = "256";
+  }
+  return presets;
 }
 
 SamiRunFile read_sami_run(const fs::path& run) {
@@ -179,15 +190,9 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     throw UserError("sami train: checkpoint_every must be positive");
   if (options.report_every < 0) throw UserError("sami train: report_every must be positive");
 
-  // SaMI's settings under the user's: trajectories as long as the env's episodes, a progress row
-  // per episode length. A resumed run keeps its checkpoint's, the user's applied over them.
-  const int horizon = sami::env_spec(id).horizon;
+  // SaMI's settings come with `cradle train`'s presets for its learners (sami_presets); a
+  // resumed run keeps its checkpoint's. The user's go over them.
   std::map<std::string, std::string> hp;
-  if (!options.resume) {
-    hp = env_defaults(id);
-    hp["horizon"] = std::to_string(horizon);
-    hp["report_every"] = std::to_string(horizon);
-  }
   if (options.report_every > 0) hp["report_every"] = std::to_string(options.report_every);
   for (const auto& [k, v] : options.hyperparameters) hp[k] = v;
 

@@ -24,6 +24,13 @@ namespace cradle::train {
 // The training task sets, one sub-env each (sami::one_set_per_env of the train split).
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id);
 
+// SaMI's settings for one of its learners (learn/meta/sami_learner.h) on an env, which `cradle
+// train` applies under the user's --hp values: trajectories and progress rows as long as the
+// env's episodes (`horizon`, `report_every`; SaMI stores whole episodes), and on Panda push its
+// replay and batch sizes (1000 trajectories, batches of 256). Empty for another algorithm.
+std::map<std::string, std::string> sami_presets(const std::string& env_id, int max_episode_steps,
+                                                const std::string& algorithm);
+
 struct SamiTrainOptions {
   // On resume, empty takes the run's (run.json); one that differs from the run's is an error.
   std::string env = "PandaPush";

@@ -92,8 +92,7 @@ TEST(SamiTrain, IsCradleTrainWithSamisSettings) {
   EXPECT_EQ(r.steps, 720);
   Config config;
   config.save_dir = (dir / "train").string();
-  hp["horizon"] = "50";  // Panda's episodes; a progress row per episode length
-  hp["report_every"] = "50";
+  // SaMI's horizon, progress rows and Panda's sizes come with cradle train's presets.
   const TrainResult t = train(config, {.env = "sami/PandaPush",
                                        .algorithm = "satesac",
                                        .intrinsic = "",
@@ -108,6 +107,10 @@ TEST(SamiTrain, IsCradleTrainWithSamisSettings) {
   EXPECT_EQ(learn::read_checkpoint_info(r.checkpoint).config,
             learn::read_checkpoint_info(t.checkpoint).config);
   EXPECT_EQ(bytes(r.checkpoint), bytes(t.checkpoint));
+  // Panda's 50-step episodes as trajectories and progress rows; the tiny sizes given win.
+  const std::string settings = learn::read_checkpoint_info(t.checkpoint).config;
+  for (const char* line : {"horizon = 50\n", "report_every = 50\n", "batch_size = 4\n"})
+    EXPECT_NE(settings.find(line), std::string::npos) << line << settings;
   std::filesystem::remove_all(dir);
 }
 
