@@ -293,6 +293,64 @@ class OldGymEnv:
 gym = types.SimpleNamespace(make=lambda env_id, **kwargs: OldGymEnv(make(env_id, **kwargs)))
 
 
+def _text(name, value):
+    if not isinstance(value, (str, os.PathLike)):
+        raise ValueError(f"{name} must be a string (got {_short(value)})")
+    return os.fspath(value)
+
+
+def run(env="stump-tracks", embodiment="old_classic_bipedal", student="sac", teacher="ALP-GMM",
+        steps=20_000_000, test_every=500_000, nb_test_episodes=100, seed=0,
+        expert_knowledge="high", test_set="", hyperparameters=None, teacher_params=None,
+        reset_frequency=0, shuffle_dimensions=False, scale_reward=False,
+        keep_periodical_task_samples=0, exp_name="test", out="", resume=False, overwrite=False,
+        progress_bar=False, **env_options):
+    """`cradle tma run` from Python: a student (sac or ppo, the reference presets) trained with a
+    teacher on TeachMyAgent's benchmark env, evaluated on the test set every test_every env steps.
+
+    The same run folder, checks and resume as the CLI (docs/tma_run.md); env_options are the
+    body and Parkour options (``motors_torque=...``); hyperparameters and teacher_params are
+    dicts (a teacher value as JSON-able data). out defaults to tma_runs/<exp_name>/<exp_name>_s<seed>.
+    Returns a dict: run, env_steps, episodes, evaluations, wall_s, env_steps_per_s,
+    gradient_steps, teacher_s, pct_mastered. Bad inputs raise ValueError (one line).
+    """
+    import json
+    a = _cradle.TmaRunArguments()
+    a.exp_name, a.env = _text("exp_name", exp_name), _text("env", env)
+    a.body, a.student = _text("embodiment", embodiment), _text("student", student)
+    a.teacher, a.expert_knowledge = _text("teacher", teacher), _text("expert_knowledge",
+                                                                      expert_knowledge)
+    a.test_set, a.out = _text("test_set", test_set), _text("out", out)
+    a.steps = _integer("steps", steps, 1, 1_000_000_000)
+    a.test_every = _integer("test_every", test_every, 1)
+    a.nb_test_episodes = _integer("nb_test_episodes", nb_test_episodes, 1, 2**31 - 1)
+    a.seed = _integer("seed", seed, 0, 2**64 - 1)
+    a.reset_frequency = _integer("reset_frequency", reset_frequency, 0)
+    a.keep_periodical_task_samples = _integer("keep_periodical_task_samples",
+                                              keep_periodical_task_samples, 0)
+    a.shuffle_dimensions = _flag("shuffle_dimensions", shuffle_dimensions)
+    a.scale_reward = _flag("scale_reward", scale_reward)
+    a.resume, a.overwrite = _flag("resume", resume), _flag("overwrite", overwrite)
+    a.progress_bar = _flag("progress_bar", progress_bar)
+    for name, value in (("hyperparameters", hyperparameters), ("teacher_params", teacher_params)):
+        if value is not None and not isinstance(value, dict):
+            raise ValueError(f"{name} must be a dict (got {_short(value)})")
+    def hp_text(v):  # as `--hp name=value` spells it: lists comma-separated, bools lower-case
+        if isinstance(v, bool):
+            return str(v).lower()
+        return ",".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
+    a.hp = [f"{k}={hp_text(v)}" for k, v in (hyperparameters or {}).items()]
+    try:
+        a.teacher_params = [f"{k}={json.dumps(v)}" for k, v in (teacher_params or {}).items()]
+    except TypeError as e:
+        raise ValueError(f"teacher_params: {e}") from None
+    unknown = sorted(set(env_options) - set(OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown option {unknown[0]} (expected one of {', '.join(OPTIONS)})")
+    a.env_options = {k: _option_text(k, v) for k, v in env_options.items()}
+    return _cradle.tma_run(a)
+
+
 
 def __getattr__(name):
     """`from cradle.tma import analysis`: the campaign analysis (python/cradle/tma_analysis.py),

@@ -66,15 +66,6 @@ tma::TaskParam parse_task(const std::string& text) {
   return p;
 }
 
-// "k=v" -> (k, v) or a one-line error naming the flag.
-std::pair<std::string, std::string> key_value(const std::string& flag, const std::string& text) {
-  const size_t eq = text.find('=');
-  if (eq == std::string::npos || eq == 0) {
-    throw UserError(flag + " '" + text + "': expected name=value");
-  }
-  return {text.substr(0, eq), text.substr(eq + 1)};
-}
-
 // The source tree's commit (through the data folder it ships), or "unknown".
 std::string source_commit() {
   const std::filesystem::path dir = tma::data_dir();
@@ -126,8 +117,9 @@ struct EnvFlags {
       if (option->count() > 0) tma::set_option(o, name, text.at(name));
     }
   }
-  nlohmann::json arguments() const {
-    nlohmann::json out = nlohmann::json::object();
+  // The options given, as text by their TmaOptions names.
+  std::map<std::string, std::string> given_text() const {
+    std::map<std::string, std::string> out;
     for (const auto& [name, option] : given) {
       if (option->count() > 0) out[name] = text.at(name);
     }
@@ -135,44 +127,12 @@ struct EnvFlags {
   }
 };
 
-// Whether the run folder's run.json records body or Parkour options.
-bool run_has_env_options(const std::filesystem::path& dir) {
-  // Only a readable file counts; the resume itself names a damaged one.
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(dir / "run.json", ec)) return false;
-  std::ifstream in(dir / "run.json");
-  if (!in) return false;
-  const nlohmann::json run = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return run.is_object() && run.contains("arguments") && run["arguments"].is_object() &&
-         run["arguments"].contains("env_options");
-}
-
-// The most --nb_env_steps (millions) a run may ask for: the paper's runs are 20.
-constexpr double kMaxMillions = 1000;
-
+// `tma run`'s flags: run.py's arguments (train::TmaRunArguments) and the CLI's own.
 struct RunOptions {
-  std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
-  std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
-  std::vector<std::string> teacher_params, hp;
-  double nb_env_steps = 20, lr = 0, min_stump_h = 0, max_stump_h = 3, max_obstacle_spacing = 6;
-  long test_every = 500000, keep_periodical_task_samples = 0, reset_frequency = 0;
-  long steps = 0;  // > 0: the budget in plain env steps (instead of --nb_env_steps)
-  int nb_test_episodes = 100;
-  std::uint64_t seed = 0;
-  bool shuffle_dimensions = false, scale_reward = false, resume = false, overwrite = false,
-       no_progress = false;
+  train::TmaRunArguments a;
+  bool no_progress = false;
   EnvFlags env_flags;
 };
-
-// The env family's half of a student run (train/tma_run.h holds the benchmark's facts).
-train::StudentEnv tma_student_env(const RunOptions& ro) {
-  tma::TmaOptions options{.env = tma::parse_env_id(ro.env), .body = ro.body};
-  ro.env_flags.apply(options);
-  return train::tma_student_env(options, {.min_stump_h = ro.min_stump_h,
-                                          .max_stump_h = ro.max_stump_h,
-                                          .max_obstacle_spacing = ro.max_obstacle_spacing,
-                                          .test_set = ro.test_set});
-}
 
 // The environment and embodiment options of `random` and `run`.
 void add_env_options(CLI::App* cmd, std::string& env, std::string& body) {
@@ -307,136 +267,64 @@ void register_tma(CLI::App& app) {
 
   auto rn = std::make_shared<RunOptions>();
   CLI::App* run = tma_cmd->add_subcommand("run", "Train a student with a teacher (run.py)");
-  run->add_option("--exp_name", rn->exp_name, "Experiment name (default run folder)");
-  add_env_options(run, rn->env, rn->body);
+  run->add_option("--exp_name", rn->a.exp_name, "Experiment name (default run folder)");
+  add_env_options(run, rn->a.env, rn->a.body);
   rn->env_flags.add(run);
-  run->add_option("--student,--algo", rn->student, "sac | ppo (the reference presets)");
-  run->add_option("--teacher", rn->teacher,
+  run->add_option("--student,--algo", rn->a.student, "sac | ppo (the reference presets)");
+  run->add_option("--teacher", rn->a.teacher,
                   "Random, ADR, ALP-GMM, Covar-GMM, RIAC, Self-Paced, GoalGAN, Setter-Solver");
-  run->add_option("--teacher-param", rn->teacher_params,
+  run->add_option("--teacher-param", rn->a.teacher_params,
                   "Teacher kwarg by the reference's name, k=v (v as JSON; repeatable)");
-  run->add_option("--allow_expert_knowledge", rn->expert_knowledge, "none | low | high");
-  run->add_option("--nb_env_steps", rn->nb_env_steps, "Training env steps, in millions");
-  run->add_option("--steps", rn->steps, "Training env steps (plain) instead of --nb_env_steps")
-      ->check(CLI::Range(1L, static_cast<long>(kMaxMillions * 1e6)))
+  run->add_option("--allow_expert_knowledge", rn->a.expert_knowledge, "none | low | high");
+  run->add_option("--nb_env_steps", rn->a.nb_env_steps, "Training env steps, in millions");
+  run->add_option("--steps", rn->a.steps, "Training env steps (plain) instead of --nb_env_steps")
+      ->check(CLI::Range(1L, static_cast<long>(train::kTmaMaxMillions * 1e6)))
       ->excludes("--nb_env_steps")
       ->default_str("");
-  run->add_option("--test_set", rn->test_set,
+  run->add_option("--test_set", rn->a.test_set,
                   "Test set of data/teachmyagent (e.g. parametric_stumps_test_set); default: "
                   "the grid (Stump Tracks) or 100 fixed uniform tasks");
-  run->add_option("--nb_test_episodes,--nb_test_episode", rn->nb_test_episodes,
+  run->add_option("--nb_test_episodes,--nb_test_episode", rn->a.nb_test_episodes,
                   "Size of the default test set");
-  run->add_option("--seed", rn->seed, "Seed of the student, teacher and shuffling")->check(kSeed);
-  run->add_option("--keep_periodical_task_samples", rn->keep_periodical_task_samples,
+  run->add_option("--seed", rn->a.seed, "Seed of the student, teacher and shuffling")->check(kSeed);
+  run->add_option("--keep_periodical_task_samples", rn->a.keep_periodical_task_samples,
                   "Env steps between 100-task curriculum snapshots (0: none)");
-  run->add_flag("--shuffle_dimensions", rn->shuffle_dimensions, "Rugged difficulty (4x4)");
-  run->add_flag("--scale_reward", rn->scale_reward, "The teacher sees returns scaled to [0, 1]");
-  run->add_option("--test_every,--steps_per_ep", rn->test_every, "Env steps between evaluations");
-  run->add_option("--reset_frequency", rn->reset_frequency,
+  run->add_flag("--shuffle_dimensions", rn->a.shuffle_dimensions, "Rugged difficulty (4x4)");
+  run->add_flag("--scale_reward", rn->a.scale_reward, "The teacher sees returns scaled to [0, 1]");
+  run->add_option("--test_every,--steps_per_ep", rn->a.test_every, "Env steps between evaluations");
+  run->add_option("--reset_frequency", rn->a.reset_frequency,
                   "Env steps between student resets (0: never; criterion 3: 7000000)");
-  run->add_option("--min_stump_h", rn->min_stump_h, "Stump Tracks: lowest mean stump height");
-  run->add_option("--max_stump_h", rn->max_stump_h, "Stump Tracks: highest mean stump height");
-  run->add_option("--max_obstacle_spacing", rn->max_obstacle_spacing,
+  run->add_option("--min_stump_h", rn->a.min_stump_h, "Stump Tracks: lowest mean stump height");
+  run->add_option("--max_stump_h", rn->a.max_stump_h, "Stump Tracks: highest mean stump height");
+  run->add_option("--max_obstacle_spacing", rn->a.max_obstacle_spacing,
                   "Stump Tracks: largest spacing");
-  run->add_option("--lr", rn->lr, "Student learning rate (default: the preset's)");
-  run->add_option("--hp", rn->hp, "Student hyperparameter override name=value (repeatable)");
-  run->add_option("--out", rn->out, "Run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)");
-  run->add_flag("--resume", rn->resume, "Continue the run in --out from its last checkpoint");
-  run->add_flag("--overwrite", rn->overwrite, "Replace the run already in --out");
+  run->add_option("--lr", rn->a.lr, "Student learning rate (default: the preset's)");
+  run->add_option("--hp", rn->a.hp, "Student hyperparameter override name=value (repeatable)");
+  run->add_option("--out", rn->a.out,
+                  "Run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)");
+  run->add_flag("--resume", rn->a.resume, "Continue the run in --out from its last checkpoint");
+  run->add_flag("--overwrite", rn->a.overwrite, "Replace the run already in --out");
   run->add_flag("--no-progress", rn->no_progress, "No progress bar");
   run->callback([rn] {
-    // --steps is the budget in env steps; recorded as the reference's millions.
-    if (rn->steps > 0) rn->nb_env_steps = static_cast<double>(rn->steps) / 1e6;
-    const RunOptions& ro = *rn;
-    if (!(ro.nb_env_steps > 0) || !std::isfinite(ro.nb_env_steps)) {
-      throw UserError("--nb_env_steps " + std::to_string(ro.nb_env_steps) +
-                      " (expected a positive number of millions)");
-    }
-    // The unit is millions (run.py's): 20000 would be 2e10 steps, weeks of a cluster.
-    if (ro.nb_env_steps > kMaxMillions) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "--nb_env_steps %g is in millions of env steps (%.3g steps): expected at most "
-                    "%g (for %g steps give %g)",
-                    ro.nb_env_steps, ro.nb_env_steps * 1e6, kMaxMillions, ro.nb_env_steps,
-                    ro.nb_env_steps / 1e6);
-      throw UserError(text);
-    }
-    train::StudentRunOptions o{
-        .student = ro.student,
-        .teacher = ro.teacher,
-        .expert_knowledge = ro.expert_knowledge,
-        .total_steps = ro.steps > 0 ? ro.steps : std::lround(ro.nb_env_steps * 1e6),
-        .test_every = ro.test_every,
-        .nb_test_episodes = ro.nb_test_episodes,
-        .seed = ro.seed,
-        .keep_periodical_task_samples = ro.keep_periodical_task_samples,
-        .shuffle_dimensions = ro.shuffle_dimensions,
-        .scale_reward = ro.scale_reward,
-        .reset_frequency = ro.reset_frequency,
-        .resume = ro.resume,
-        .overwrite = ro.overwrite,
-        .progress_bar = !ro.no_progress};
-    for (const std::string& kv : ro.teacher_params) {
-      const auto [k, v] = key_value("--teacher-param", kv);
-      o.teacher_params[k] =
-          nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
-    }
-    if (ro.lr != 0) o.hyperparameters["learning_rate"] = std::to_string(ro.lr);
-    // The same name twice (or learning_rate with --lr) would keep only one value, silently.
-    for (const std::string& kv : ro.hp) {
-      const auto [k, v] = key_value("--hp", kv);
-      if (!o.hyperparameters.emplace(k, v).second)
-        throw UserError("--hp " + k + " is given twice" +
-                        (k == "learning_rate" && ro.lr != 0 ? " (also by --lr)" : "") +
-                        "; expected each name once");
-    }
-    o.out = ro.out.empty() ? std::filesystem::path("tma_runs") / ro.exp_name /
-                                 (ro.exp_name + "_s" + std::to_string(ro.seed))
-                           : std::filesystem::path(ro.out);
-    o.arguments = {{"exp_name", ro.exp_name},
-                   {"env", ro.env},
-                   {"embodiment", ro.body},
-                   {"student", ro.student},
-                   {"teacher", ro.teacher},
-                   {"teacher_params", o.teacher_params},
-                   {"allow_expert_knowledge", ro.expert_knowledge},
-                   {"nb_env_steps", ro.nb_env_steps},
-                   {"test_set", ro.test_set},
-                   {"nb_test_episodes", ro.nb_test_episodes},
-                   {"seed", ro.seed},
-                   {"keep_periodical_task_samples", ro.keep_periodical_task_samples},
-                   {"shuffle_dimensions", ro.shuffle_dimensions},
-                   {"scale_reward", ro.scale_reward},
-                   {"test_every", ro.test_every},
-                   {"reset_frequency", ro.reset_frequency},
-                   {"min_stump_h", ro.min_stump_h},
-                   {"max_stump_h", ro.max_stump_h},
-                   {"max_obstacle_spacing", ro.max_obstacle_spacing},
-                   {"lr", ro.lr},
-                   {"hp", ro.hp},
-                   {"out", o.out.string()},
-                   {"resume", ro.resume}};
-    // Recorded when given, or when resuming a run that has them (so that leaving them out is
-    // refused by name); runs without them resume as before.
-    const nlohmann::json env_options = ro.env_flags.arguments();
-    if (!env_options.empty() || (ro.resume && run_has_env_options(o.out))) {
-      o.arguments["env_options"] = env_options;
-    }
-    o.commit = source_commit();
+    train::TmaRunArguments a = rn->a;
+    a.progress_bar = !rn->no_progress;
+    a.env_options = rn->env_flags.given_text();
+    a.commit = source_commit();
     // Ctrl-C or a scheduler's SIGTERM ends the run at its next report instead of killing it.
-    o.stop = stop_on({SIGINT, SIGTERM});
-    const train::StudentRunResult r = train::run_student(tma_student_env(ro), o);
+    a.stop = stop_on({SIGINT, SIGTERM});
+    const train::TmaRun run = train::run_tma(a);
+    const train::StudentRunResult& r = run.result;
+    const std::filesystem::path& out = run.out;
     std::printf(
         "%s: %ld env steps, %ld episodes, %d evaluations, %.1f s, %.0f env steps/s, %.1f "
         "gradient steps/s, teacher %.2f%% of the time, %.0f%% mastered\n",
-        o.out.string().c_str(), r.env_steps, r.episodes, r.evaluations, r.wall_s, r.env_steps_per_s,
+        out.string().c_str(), r.env_steps, r.episodes, r.evaluations, r.wall_s, r.env_steps_per_s,
         r.gradient_steps_per_s, 100 * r.teacher_s / std::max(r.wall_s, 1e-9), r.last_pct_mastered);
     if (r.stopped) {
       std::printf(
           "stopped by a signal at %ld env steps; --resume continues from the checkpoint at %ld env "
           "steps (the last evaluation): cradle tma run ... --out %s --resume\n",
-          r.env_steps, r.checkpoint_steps, o.out.string().c_str());
+          r.env_steps, r.checkpoint_steps, out.string().c_str());
       throw Stopped{};  // exit 130: `tma campaign` must not count the seed as finished
     }
   });

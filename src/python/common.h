@@ -84,6 +84,7 @@ void bind_sami(py::module_& m);
 void bind_teach(py::module_& m);
 void bind_registry(py::module_& m);    // registry.cc, after bind_env and bind_sami (their views)
 void bind_sami_learn(py::module_& m);  // sami_learn.cc, called by bind_sami
+void bind_tma_run(py::module_& m);     // tma_run.cc, called by bind_tma
 void bind_run_policy(py::module_& m);  // run_policy.cc: a run's trained policy, by its folder
 
 }  // namespace cradle::python

@@ -96,6 +96,7 @@ void bind_tma(py::module_& m) {
   m.def("tma_embodiments", [] { return tma::embodiment_names(); });
   m.def("tma_option_names", [] { return tma::option_names(); });
   m.def("tma_data_dir", [] { return tma::data_dir().string(); });
+  bind_tma_run(m);
 }
 
 }  // namespace cradle::python

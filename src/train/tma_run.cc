@@ -646,4 +646,121 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
   return result;
 }
 
+namespace {
+
+// "k=v" -> (k, v) or a one-line error naming the flag.
+std::pair<std::string, std::string> key_value(const std::string& flag, const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UserError(flag + " '" + text + "': expected name=value");
+  }
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+// Whether the run folder's run.json records body or Parkour options.
+bool run_has_env_options(const fs::path& dir) {
+  // Only a readable file counts; the resume itself names a damaged one.
+  std::error_code ec;
+  if (!fs::is_regular_file(dir / "run.json", ec)) return false;
+  std::ifstream in(dir / "run.json");
+  if (!in) return false;
+  const nlohmann::json run = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return run.is_object() && run.contains("arguments") && run["arguments"].is_object() &&
+         run["arguments"].contains("env_options");
+}
+
+}  // namespace
+
+TmaRun run_tma(const TmaRunArguments& a) {
+  // --steps is the budget in env steps; recorded as the reference's millions.
+  const double millions = a.steps > 0 ? static_cast<double>(a.steps) / 1e6 : a.nb_env_steps;
+  if (a.steps < 0 || a.steps > static_cast<long>(kTmaMaxMillions * 1e6)) {
+    throw UserError("--steps " + std::to_string(a.steps) + " (expected 1 to " +
+                    std::to_string(static_cast<long>(kTmaMaxMillions * 1e6)) + " env steps)");
+  }
+  if (!(millions > 0) || !std::isfinite(millions)) {
+    throw UserError("--nb_env_steps " + std::to_string(millions) +
+                    " (expected a positive number of millions)");
+  }
+  // The unit is millions (run.py's): 20000 would be 2e10 steps, weeks of a cluster.
+  if (millions > kTmaMaxMillions) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--nb_env_steps %g is in millions of env steps (%.3g steps): expected at most "
+                  "%g (for %g steps give %g)",
+                  millions, millions * 1e6, kTmaMaxMillions, millions, millions / 1e6);
+    throw UserError(text);
+  }
+  StudentRunOptions o{.student = a.student,
+                      .teacher = a.teacher,
+                      .expert_knowledge = a.expert_knowledge,
+                      .total_steps = a.steps > 0 ? a.steps : std::lround(millions * 1e6),
+                      .test_every = a.test_every,
+                      .nb_test_episodes = a.nb_test_episodes,
+                      .seed = a.seed,
+                      .keep_periodical_task_samples = a.keep_periodical_task_samples,
+                      .shuffle_dimensions = a.shuffle_dimensions,
+                      .scale_reward = a.scale_reward,
+                      .reset_frequency = a.reset_frequency,
+                      .resume = a.resume,
+                      .overwrite = a.overwrite,
+                      .progress_bar = a.progress_bar};
+  for (const std::string& kv : a.teacher_params) {
+    const auto [k, v] = key_value("--teacher-param", kv);
+    o.teacher_params[k] = nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
+  }
+  if (a.lr != 0) o.hyperparameters["learning_rate"] = std::to_string(a.lr);
+  // The same name twice (or learning_rate with --lr) would keep only one value, silently.
+  for (const std::string& kv : a.hp) {
+    const auto [k, v] = key_value("--hp", kv);
+    if (!o.hyperparameters.emplace(k, v).second)
+      throw UserError("--hp " + k + " is given twice" +
+                      (k == "learning_rate" && a.lr != 0 ? " (also by --lr)" : "") +
+                      "; expected each name once");
+  }
+  o.out = a.out.empty()
+              ? fs::path("tma_runs") / a.exp_name / (a.exp_name + "_s" + std::to_string(a.seed))
+              : fs::path(a.out);
+  o.arguments = {{"exp_name", a.exp_name},
+                 {"env", a.env},
+                 {"embodiment", a.body},
+                 {"student", a.student},
+                 {"teacher", a.teacher},
+                 {"teacher_params", o.teacher_params},
+                 {"allow_expert_knowledge", a.expert_knowledge},
+                 {"nb_env_steps", millions},
+                 {"test_set", a.test_set},
+                 {"nb_test_episodes", a.nb_test_episodes},
+                 {"seed", a.seed},
+                 {"keep_periodical_task_samples", a.keep_periodical_task_samples},
+                 {"shuffle_dimensions", a.shuffle_dimensions},
+                 {"scale_reward", a.scale_reward},
+                 {"test_every", a.test_every},
+                 {"reset_frequency", a.reset_frequency},
+                 {"min_stump_h", a.min_stump_h},
+                 {"max_stump_h", a.max_stump_h},
+                 {"max_obstacle_spacing", a.max_obstacle_spacing},
+                 {"lr", a.lr},
+                 {"hp", a.hp},
+                 {"out", o.out.string()},
+                 {"resume", a.resume}};
+  // Recorded when given, or when resuming a run that has them (so that leaving them out is
+  // refused by name); runs without them resume as before.
+  nlohmann::json env_options = nlohmann::json::object();
+  for (const auto& [name, value] : a.env_options) env_options[name] = value;
+  if (!env_options.empty() || (a.resume && run_has_env_options(o.out))) {
+    o.arguments["env_options"] = env_options;
+  }
+  o.commit = a.commit;
+  o.stop = a.stop;
+  // The env family's half of the run: the env with its options and the benchmark's facts.
+  tma::TmaOptions options{.env = tma::parse_env_id(a.env), .body = a.body};
+  for (const auto& [name, value] : a.env_options) tma::set_option(options, name, value);
+  const StudentEnv env = tma_student_env(options, {.min_stump_h = a.min_stump_h,
+                                                   .max_stump_h = a.max_stump_h,
+                                                   .max_obstacle_spacing = a.max_obstacle_spacing,
+                                                   .test_set = a.test_set});
+  return {.out = o.out, .result = run_student(env, o)};
+}
+
 }  // namespace cradle::train

@@ -97,4 +97,33 @@ std::map<std::string, std::string> student_preset(const std::string& student, lo
 // option, an unknown teacher or student, or a resume whose arguments differ from run.json's.
 StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& options);
 
+// The most --nb_env_steps (millions) a run may ask for: the paper's runs are 20.
+constexpr double kTmaMaxMillions = 1000;
+
+// `cradle tma run`'s arguments, by run.py's names, as the CLI and Python give them: run_tma
+// checks them, records them in run.json (a resume compares them) and runs the student on
+// TeachMyAgent's benchmark env.
+struct TmaRunArguments {
+  std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
+  std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
+  std::vector<std::string> teacher_params, hp;  // "name=value" (a teacher value as JSON)
+  double nb_env_steps = 20;                     // millions (run.py's unit)
+  long steps = 0;                               // > 0: the budget in env steps instead
+  double lr = 0, min_stump_h = 0, max_stump_h = 3, max_obstacle_spacing = 6;
+  long test_every = 500000, keep_periodical_task_samples = 0, reset_frequency = 0;
+  int nb_test_episodes = 100;
+  std::uint64_t seed = 0;
+  bool shuffle_dimensions = false, scale_reward = false, resume = false, overwrite = false;
+  bool progress_bar = true;
+  // Body and Parkour options given (tma::set_option's names: motors_torque, nb_of_bodies, ...).
+  std::map<std::string, std::string> env_options;
+  std::string commit = "unknown";
+  const std::atomic<bool>* stop = nullptr;
+};
+struct TmaRun {
+  std::filesystem::path out;  // the run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)
+  StudentRunResult result;
+};
+TmaRun run_tma(const TmaRunArguments& arguments);
+
 }  // namespace cradle::train
