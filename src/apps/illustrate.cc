@@ -122,15 +122,7 @@ void run(const IllustrateOptions& o) {
   if (!o.load_model.empty() && !fs::is_regular_file(o.load_model)) {
     throw UserError("--load_model '" + o.load_model + "' does not exist");
   }
-  std::map<std::string, std::string> hyperparameters;
-  for (const std::string& kv : o.hp) {
-    const size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw UserError("--hp '" + kv + "': expected name=value");
-    // The same name twice would keep only one of the values, silently.
-    if (!hyperparameters.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
-      throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
-  }
+  std::map<std::string, std::string> hyperparameters = learn::parse_hyperparameter_flags(o.hp);
   // Models trained before under this name are never replaced silently.
   const fs::path saved = fs::path("models") / o.env / o.save_model;
   if (o.train_for > 0 && !o.overwrite && fs::exists(saved / "progress.csv")) {

@@ -25,6 +25,7 @@
 #include "core/image.h"
 #include "core/rng.h"
 #include "eval/video.h"
+#include "learn/hyperparams.h"
 #include "learn/meta/sami_learner.h"
 #include "sami/env.h"
 #include "sami/render.h"
@@ -147,20 +148,6 @@ void random_episodes(const std::string& name, const std::string& split, int epis
   }
 }
 
-std::map<std::string, std::string> parse_hp(const std::vector<std::string>& pairs) {
-  std::map<std::string, std::string> out;
-  for (const std::string& kv : pairs) {
-    const size_t eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      throw UserError("--hp '" + kv + "': expected name=value");
-    }
-    // The same name twice would keep only one of the values, silently.
-    if (!out.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
-      throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
-  }
-  return out;
-}
-
 // train / evaluate / table.
 void register_learners(CLI::App& cmd) {
   struct Options {
@@ -220,7 +207,7 @@ void register_learners(CLI::App& cmd) {
     // The learner registry's names (`cradle train --algo saccm`) name the same methods.
     if (const std::string_view m = learn::meta::sami_method(opts->train.method); !m.empty())
       opts->train.method = std::string(m);
-    opts->train.hyperparameters = parse_hp(opts->hp);
+    opts->train.hyperparameters = learn::parse_hyperparameter_flags(opts->hp);
     opts->train.out = opts->out;
     opts->train.stop = stop_on({SIGINT, SIGTERM});
     const train::SamiTrainResult r = train::sami_train(opts->train);

@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "dist/process_group.h"
 #include "envs/registry.h"
+#include "learn/hyperparams.h"
 #include "learn/registry.h"
 #include "train/dist_sync.h"
 #include "train/trainer.h"
@@ -173,15 +174,7 @@ void register_train(CLI::App& app) {
       config.save_dir = "results/" + train::registered_env_id(opts->train.env);
     }
     if (!opts->save_dir.empty()) config.save_dir = opts->save_dir;
-    for (const std::string& kv : opts->hp) {
-      const size_t eq = kv.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        throw UserError("--hp '" + kv + "': expected name=value");
-      }
-      // The same name twice would keep only one of the values, silently.
-      if (!opts->train.hyperparameters.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
-        throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
-    }
+    opts->train.hyperparameters = learn::parse_hyperparameter_flags(opts->hp);
     // Ctrl-C, or SIGTERM from srun, `cradle launch` or a scheduler's time limit, ends the run at
     // its next update with a checkpoint.
     opts->train.stop = stop_on({SIGINT, SIGTERM});

@@ -146,6 +146,20 @@ std::string Hyperparameters::describe() const {
   return text;
 }
 
+std::map<std::string, std::string> parse_hyperparameter_flags(
+    const std::vector<std::string>& flags) {
+  std::map<std::string, std::string> out;
+  for (const std::string& kv : flags) {
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw UserError("--hp '" + kv + "': expected name=value");
+    }
+    if (!out.emplace(kv.substr(0, eq), kv.substr(eq + 1)).second)
+      throw UserError("--hp " + kv.substr(0, eq) + " is given twice; expected each name once");
+  }
+  return out;
+}
+
 std::map<std::string, std::string> parse_hyperparameter_text(std::string_view text) {
   std::map<std::string, std::string> values;
   std::istringstream lines{std::string(text)};

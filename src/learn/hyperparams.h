@@ -41,4 +41,9 @@ class Hyperparameters {
 // starting with '#' are skipped). Throws UserError for a line without '='.
 std::map<std::string, std::string> parse_hyperparameter_text(std::string_view text);
 
+// `--hp name=value` flags as overrides. UserError for a flag without a name or '=' and for a name
+// given twice (one of its values would be dropped silently).
+std::map<std::string, std::string> parse_hyperparameter_flags(
+    const std::vector<std::string>& flags);
+
 }  // namespace cradle::learn

@@ -13,6 +13,7 @@
 #include "core/jsonl.h"
 #include "core/sealed_file.h"
 #include "envs/tma/tma_env.h"
+#include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/registry.h"
 #include "learn/run_files.h"
@@ -709,15 +710,10 @@ TmaRun run_tma(const TmaRunArguments& a) {
     const auto [k, v] = key_value("--teacher-param", kv);
     o.teacher_params[k] = nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
   }
-  if (a.lr != 0) o.hyperparameters["learning_rate"] = std::to_string(a.lr);
-  // The same name twice (or learning_rate with --lr) would keep only one value, silently.
-  for (const std::string& kv : a.hp) {
-    const auto [k, v] = key_value("--hp", kv);
-    if (!o.hyperparameters.emplace(k, v).second)
-      throw UserError("--hp " + k + " is given twice" +
-                      (k == "learning_rate" && a.lr != 0 ? " (also by --lr)" : "") +
-                      "; expected each name once");
-  }
+  o.hyperparameters = learn::parse_hyperparameter_flags(a.hp);
+  // learning_rate with --lr would keep only one value, silently.
+  if (a.lr != 0 && !o.hyperparameters.emplace("learning_rate", std::to_string(a.lr)).second)
+    throw UserError("--hp learning_rate is given twice (also by --lr); expected each name once");
   o.out = a.out.empty()
               ? fs::path("tma_runs") / a.exp_name / (a.exp_name + "_s" + std::to_string(a.seed))
               : fs::path(a.out);
