@@ -396,6 +396,19 @@ struct SeedRun {
   fs::path dir;
 };
 
+// Whether a run's checkpoints/final.ckpt holds `steps` (a run stopped early saves one too); a
+// missing or damaged one holds none.
+bool final_checkpoint_holds(const fs::path& dir, long steps) {
+  const fs::path final_ckpt = dir / "checkpoints" / "final.ckpt";
+  std::error_code ec;
+  if (!fs::exists(final_ckpt, ec)) return false;
+  try {
+    return learn::read_checkpoint_info(final_ckpt).steps >= steps;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 // What the kind's command leaves in its folder when it is done.
 std::string done_by_files(const SeedRun& r) {
   std::error_code ec;
@@ -403,33 +416,23 @@ std::string done_by_files(const SeedRun& r) {
     case RunKind::kTma:
       return fs::exists(r.dir / "done.json", ec) ? "done.json" : "";
     case RunKind::kSami: {
-      // The whole budget in checkpoints/final.ckpt (a stopped run saves one too), then every
-      // evaluation.
-      const fs::path final_ckpt = r.dir / "checkpoints" / "final.ckpt";
-      if (!fs::exists(final_ckpt, ec)) return "";
+      // The whole budget in checkpoints/final.ckpt, then every evaluation.
+      long budget = 0;
       try {
-        const train::SamiRunFile run = train::read_sami_run(r.dir);
-        if (learn::read_checkpoint_info(final_ckpt).steps < run.steps_per_env * run.envs) return "";
+        budget = train::read_sami_run(r.dir).steps;
       } catch (const std::exception&) {
         return "";  // a damaged run is no finished run (the seed runs again and says why)
       }
+      if (!final_checkpoint_holds(r.dir, budget)) return "";
       for (const std::string& split : r.line->eval_splits) {
         if (!fs::exists(r.dir / ("eval_" + split + ".json"), ec)) return "";
       }
       return "checkpoints/final.ckpt";
     }
-    case RunKind::kTrain: {
-      const fs::path final_ckpt = r.dir / "checkpoints" / "final.ckpt";
-      if (!fs::exists(final_ckpt, ec)) return "";
+    case RunKind::kTrain:
+      if (!final_checkpoint_holds(r.dir, r.line->train_steps)) return "";
       if (r.line->train_evaluates && !fs::exists(r.dir / "evaluation.json", ec)) return "";
-      try {
-        // A run stopped early also saves final.ckpt: it must hold the asked steps.
-        if (learn::read_checkpoint_info(final_ckpt).steps < r.line->train_steps) return "";
-      } catch (const std::exception&) {
-        return "";
-      }
       return "checkpoints/final.ckpt";
-    }
   }
   return "";
 }

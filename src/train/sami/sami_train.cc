@@ -111,7 +111,7 @@ SamiRunFile read_sami_run(const fs::path& run) {
                 .seed = j.unsigned_integer("seed"),
                 .envs = j.positive_integer("envs"),
                 .hyperparameters = j.string_map("hyperparameters")};
-  const long steps = j.positive_integer("steps");
+  r.steps = j.positive_integer("steps");
   const std::string family = j.string("family");
   // A run of another family or learner names the file it came from.
   if (family != "sami" || !r.env_id.starts_with("sami/")) {
@@ -130,7 +130,7 @@ SamiRunFile read_sami_run(const fs::path& run) {
   } catch (const UserError& e) {
     throw UserError(j.where() + ": " + e.what());
   }
-  r.steps_per_env = (steps + r.envs - 1) / r.envs;
+  r.steps_per_env = (r.steps + r.envs - 1) / r.envs;
   return r;
 }
 

@@ -72,7 +72,8 @@ struct SamiRunFile {
   std::string method;     // "SaCCM"
   std::uint64_t seed = 0;
   long envs = 0;                                       // training envs
-  long steps_per_env = 0;                              // the budget per env
+  long steps = 0;                                      // the budget in env steps, all envs
+  long steps_per_env = 0;                              // the budget per env (rounded up)
   std::map<std::string, std::string> hyperparameters;  // the values given
 };
 SamiRunFile read_sami_run(const std::filesystem::path& run);
