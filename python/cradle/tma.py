@@ -17,6 +17,7 @@ same env with the reference's old Gym API (``reset() -> obs``, ``step() -> obs, 
 info``), so the TeachMyAgent README example runs with ``from cradle.tma import gym``.
 """
 
+import json
 import numbers
 import os
 import sys
@@ -314,7 +315,6 @@ def run(env="stump-tracks", embodiment="old_classic_bipedal", student="sac", tea
     Returns a dict: run, env_steps, episodes, evaluations, wall_s, env_steps_per_s,
     gradient_steps, teacher_s, pct_mastered. Bad inputs raise ValueError (one line).
     """
-    import json
     a = _cradle.TmaRunArguments()
     a.exp_name, a.env = _text("exp_name", exp_name), _text("env", env)
     a.body, a.student = _text("embodiment", embodiment), _text("student", student)

@@ -148,6 +148,8 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   std::string env_name = options.env, method = options.method;
   std::uint64_t seed = options.seed;
   long steps_per_env = options.steps_per_env;
+  // What the folder holds already (a fresh run refuses it without --overwrite, which clears it).
+  const fs::path held = options.resume ? fs::path() : held_run(run);
   if (options.resume) {
     const SamiRunFile saved = read_sami_run(run);
     // A resumed run keeps its env and method: one given that contradicts them is refused, not
@@ -175,7 +177,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     method = saved.method;
     seed = saved.seed;
     if (steps_per_env == 0) steps_per_env = saved.steps_per_env;
-  } else if (const fs::path held = held_run(run); !held.empty() && !options.overwrite) {
+  } else if (!held.empty() && !options.overwrite) {
     throw UserError("sami train: " + run.string() + " already holds a run (" + held.string() +
                     "): pass --resume to continue it, --overwrite to replace it, or another --out");
   }
@@ -198,7 +200,7 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
 
   // An overwritten run's evaluations go with it (`cradle train` removes its logs and
   // checkpoints, and an earlier layout's files go here).
-  if (options.overwrite && !held_run(run).empty()) {
+  if (options.overwrite && !held.empty()) {
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(run, ec)) {
       const std::string name = entry.path().filename().string();
