@@ -3,8 +3,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <system_error>
 
 #include "core/error.h"
@@ -106,6 +108,9 @@ void save_run_checkpoint(const fs::path& file, const Learner& learner,
   Sections sections = read_sealed(part, "checkpoint");
   nlohmann::json state{{"steps", run.steps}, {"episodes", run.episodes}};
   if (run.intrinsic) state["intrinsic"] = *run.intrinsic;
+  // Only runs that keep such logs record them: the other checkpoints stay as they were.
+  if (!run.log_sizes.empty()) state["log_sizes"] = run.log_sizes;
+  if (!run.teacher_steps.empty()) state["teacher_steps"] = run.teacher_steps;
   sections[kRunSection] = state.dump();
   if (reward) {
     const Staging staging(file);
@@ -138,6 +143,24 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
       throw UserError(file.string() + ": checkpoint run state is malformed");
     state.intrinsic = j["intrinsic"].get<std::string>();
   }
+  // Counts by paths inside the run folder (sizes in bytes, teacher steps).
+  for (const char* key : {"log_sizes", "teacher_steps"}) {
+    if (!j.contains(key)) continue;
+    if (!j[key].is_object())
+      throw UserError(file.string() + ": checkpoint run state is malformed (" + key + ")");
+    for (const auto& [name, count] : j[key].items()) {
+      const fs::path path(name);
+      bool inside = !name.empty() && path.is_relative();
+      for (const fs::path& part : path) inside = inside && part != "..";
+      if (!inside || !count.is_number_unsigned())
+        throw UserError(file.string() + ": checkpoint run state is malformed (" + key + ": " +
+                        name + ")");
+      if (key == std::string("log_sizes"))
+        state.log_sizes[name] = count.get<std::uintmax_t>();
+      else
+        state.teacher_steps[name] = count.get<long>();
+    }
+  }
   if (reward) {
     const Staging staging(file);
     for (const auto& [name, bytes] : sections) {
@@ -156,6 +179,30 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
     }
   }
   return state;
+}
+
+void cut_to_checkpoint(const fs::path& file, std::uintmax_t size) {
+  std::error_code ec;
+  const std::uintmax_t now = fs::exists(file, ec) ? fs::file_size(file, ec) : 0;
+  if (now < size) {
+    throw UserError("--resume: '" + file.string() + "' is shorter than at the checkpoint (" +
+                    std::to_string(now) + " < " + std::to_string(size) + " bytes)");
+  }
+  if (now == size) return;
+  std::ifstream in(file, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(size));
+  std::ostringstream tail;
+  tail << in.rdbuf();
+  in.close();
+  const fs::path aside =
+      file.parent_path() / (file.stem().string() + ".after-checkpoint" + file.extension().string());
+  std::ofstream out(aside, std::ios::app | std::ios::binary);
+  out << tail.str();
+  if (!out.flush()) throw UserError("cannot write '" + aside.string() + "'");
+  fs::resize_file(file, size, ec);
+  if (ec) throw UserError("cannot cut '" + file.string() + "': " + ec.message());
+  std::cerr << file.filename().string() << ": lines after the checkpoint kept in " << aside.string()
+            << "\n";
 }
 
 long cut_training_log(const fs::path& log, long episodes) {

@@ -5,7 +5,9 @@
 // repaired).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +27,13 @@ struct RunState {
   // The run's intrinsic rewards as Composite::describe() writes them ("" none); absent in
   // checkpoints of earlier builds.
   std::optional<std::string> intrinsic;
+  // The run's append-only logs beside the training log (the teacher's book of each rank), by path
+  // in the run folder, and their sizes in bytes at the checkpoint: a resume cuts each back to it.
+  // Empty for runs without such logs and in checkpoints of earlier builds.
+  std::map<std::string, std::uintmax_t> log_sizes;
+  // The step counts of each rank's teacher controller (by its book's path): the env steps its
+  // envs took, which autoreset steps do not count, so not `steps`.
+  std::map<std::string, long> teacher_steps;
 };
 
 // Writes `file`: the learner's checkpoint with sections "run" (RunState as JSON) and
@@ -40,6 +49,12 @@ RunState load_run_state(const std::filesystem::path& file, intrinsic::IntrinsicR
 // line are appended to training.after-checkpoint.jsonl beside it. Returns how many entries were
 // kept (fewer than `episodes` only if the log lost some).
 long cut_training_log(const std::filesystem::path& log, long episodes);
+
+// Cuts `file` back to its first `size` bytes (its size at a checkpoint); what follows goes to
+// <stem>.after-checkpoint<ext> beside it (appended, never lost) and one line on stderr says so.
+// UserError when the file is shorter than `size` (it lost what the checkpoint knows) or cannot be
+// cut.
+void cut_to_checkpoint(const std::filesystem::path& file, std::uintmax_t size);
 
 // Renames a log written with other columns to <stem>.before-resume<ext> beside it (-2, -3, ...
 // after the stem when taken) and returns the new path; UserError when the rename fails.

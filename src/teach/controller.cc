@@ -394,6 +394,11 @@ void TeacherController::replay_periodical(PeriodicalRecord record) {
   periodical_taken_ = periodical_.size();
 }
 
+void TeacherController::continue_from(long env_steps) {
+  std::lock_guard lock(mutex_);
+  steps_ = std::max(steps_, env_steps);
+}
+
 Task TeacherController::next_test_task() {
   std::lock_guard lock(mutex_);
   const Task t = test_set_[next_test_];

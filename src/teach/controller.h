@@ -137,6 +137,9 @@ class TeacherController {
   // and discarded first so its state advances as it did), and sets the step count.
   void replay_train_episode(const Task& real, double ret, int length, bool success, long env_steps);
   void replay_periodical(PeriodicalRecord record);
+  // Resume: the step count of the checkpoint the run continues from (the book's last episode may
+  // have ended before it), so that later episodes and snapshots count on from there.
+  void continue_from(long env_steps);
 
   // The test set in order; test_task walks through it and wraps around (books it).
   int test_set_size() const { return static_cast<int>(test_set_.size()); }

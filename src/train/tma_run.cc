@@ -40,31 +40,6 @@ const char* const kLogs[] = {"progress.csv", "test_returns.csv", "teacher.jsonl"
 // Arguments a resumed run may change.
 const char* const kResumable[] = {"nb_env_steps", "test_every", "resume", "out", "progress_bar"};
 
-// Cuts `file` back to `size` bytes; what follows goes to <stem>.after-checkpoint<ext>.
-void cut_back(const fs::path& file, std::uintmax_t size) {
-  std::error_code ec;
-  const std::uintmax_t now = fs::exists(file, ec) ? fs::file_size(file, ec) : 0;
-  if (now < size) {
-    throw UserError("--resume: '" + file.string() + "' is shorter than at the checkpoint (" +
-                    std::to_string(now) + " < " + std::to_string(size) + " bytes)");
-  }
-  if (now == size) return;
-  std::ifstream in(file, std::ios::binary);
-  in.seekg(static_cast<std::streamoff>(size));
-  std::ostringstream tail;
-  tail << in.rdbuf();
-  in.close();
-  const fs::path aside =
-      file.parent_path() / (file.stem().string() + ".after-checkpoint" + file.extension().string());
-  std::ofstream out(aside, std::ios::app | std::ios::binary);
-  out << tail.str();
-  if (!out.flush()) throw UserError("cannot write '" + aside.string() + "'");
-  fs::resize_file(file, size, ec);
-  if (ec) throw UserError("cannot cut '" + file.string() + "': " + ec.message());
-  std::cerr << file.filename().string() << ": lines after the checkpoint kept in " << aside.string()
-            << "\n";
-}
-
 // Splits a CSV line of plain cells (our logs hold numbers and names, never quotes).
 std::vector<std::string> split_cells(const std::string& line) {
   std::vector<std::string> cells;
@@ -394,7 +369,7 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
     }
     // The teacher's book is checked whole before the logs are cut back to the checkpoint.
     check_teacher_book(dir / "teacher.jsonl", env.space.dims());
-    for (const char* name : kLogs) cut_back(dir / name, state.sizes[name]);
+    for (const char* name : kLogs) learn::cut_to_checkpoint(dir / name, state.sizes[name]);
   } else {
     make_folder(dir, "cannot create the run folder");
     make_folder(checkpoints, "cannot create the run folder");

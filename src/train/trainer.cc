@@ -345,20 +345,32 @@ void open_run_folder(Run& run) {
   }
 }
 
+// A rank's teacher book: its path in the run folder (the checkpoint records its size by it).
+std::string teacher_book(int rank) {
+  return rank == 0 ? "logs/teacher.jsonl" : "ranks/" + std::to_string(rank) + "/logs/teacher.jsonl";
+}
+
 // With a task space, the teacher's controller (one per rank), the wrapper through which it sets
-// every env's reset options, and its book, logs/teacher.jsonl (replayed into a resumed teacher).
+// every env's reset options, and its book, logs/teacher.jsonl: on resume cut back to what the
+// checkpoint knows (episodes booked after it are played again) and replayed into the teacher.
 void make_curriculum(Run& run) {
   if (!run.curriculum_spec) return;
   const TrainOptions& options = run.options;
-  const fs::path teacher_file = fs::path(run.env_config.save_dir) / "logs" / "teacher.jsonl";
+  const fs::path teacher_file = run.dir / teacher_book(run.rank);
   const std::uint64_t teacher_seed = options.seed + run.rank;
   const CurriculumSpec& spec = *run.curriculum_spec;
   run.curriculum =
       options.teacher_factory
           ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed)
           : make_controller(spec, teacher_seed);
-  if (options.resume && fs::exists(teacher_file))
+  if (options.resume && fs::exists(teacher_file)) {
+    const auto size = run.resumed.log_sizes.find(teacher_book(run.rank));
+    if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(teacher_file, size->second);
     replay_teacher_book(*run.curriculum, teacher_file, /*periodical=*/false);
+    // The controller's step count at the checkpoint (its last booked episode may be earlier).
+    const auto steps = run.resumed.teacher_steps.find(teacher_book(run.rank));
+    if (steps != run.resumed.teacher_steps.end()) run.curriculum->continue_from(steps->second);
+  }
   run.wrap = [curriculum = run.curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
     return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
   };
@@ -486,9 +498,23 @@ void open_logs(Run& run) {
 void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
   run.training.end_episodes();
   if (run.training.log) run.training.log->flush();
-  const RunState state{.steps = run.learner->steps(),
-                       .episodes = run.training.log ? run.training.log->episodes() : 0,
-                       .intrinsic = run.reward ? run.reward->describe() : ""};
+  RunState state{.steps = run.learner->steps(),
+                 .episodes = run.training.log ? run.training.log->episodes() : 0,
+                 .intrinsic = run.reward ? run.reward->describe() : ""};
+  // The teacher books of every rank as long as the episodes the checkpoint knows.
+  if (run.teacher_log) {
+    write_teacher_log(run, false);
+    // Each rank's size and step count in its slots, summed over the ranks.
+    const int ranks = run.sync ? run.sync->world_size() : 1;
+    std::vector<double> counts(2 * ranks, 0.0);
+    counts[2 * run.rank] = static_cast<double>(fs::file_size(run.dir / teacher_book(run.rank)));
+    counts[2 * run.rank + 1] = static_cast<double>(run.curriculum->env_steps());
+    if (run.sync) run.sync->all_reduce_sum(counts);
+    for (int r = 0; r < ranks; ++r) {
+      state.log_sizes[teacher_book(r)] = static_cast<std::uintmax_t>(counts[2 * r]);
+      state.teacher_steps[teacher_book(r)] = static_cast<long>(counts[2 * r + 1]);
+    }
+  }
   if (run.rank > 0) return;
   for (const fs::path& file : files)
     save_run_checkpoint(file, *run.learner, run.reward.get(), state);
@@ -583,8 +609,9 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   if (run.learner->steps() >= next_checkpoint) {
     files.push_back(run.checkpoints / ("step_" + std::to_string(run.learner->steps()) + ".ckpt"));
   }
-  save_checkpoint(run, files);
+  // The teacher's state closes its book before the checkpoint records the book's size.
   write_teacher_log(run, true);
+  save_checkpoint(run, files);
   VecEnv& vec = *run.training.vec;
   for (int i = 0; i < vec.num_envs(); ++i) vec.env(i).close();
   result.parameter_hash = run.learner->parameter_hash();

@@ -82,6 +82,61 @@ TEST(TrainEnv, CatchCurriculumTrainsWritesTheBooksAndResumes) {
   EXPECT_EQ(dumps, 2);
 }
 
+// A run killed after its checkpoint at 256 steps, its teacher's book already 512 steps long (made
+// here by putting the step-256 checkpoint back as latest.ckpt): the resume cuts the book back to
+// the checkpoint, keeps the later lines aside, and books the replayed steps' episodes once, the
+// teacher counting its steps on from the checkpoint's.
+TEST(TrainEnv, AResumeCutsTheTeachersBookBackToItsCheckpoint) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_book");
+  const std::string file = std::string(CRADLE_SOURCE_DIR) + "/configs/curricula/mimo_catch.yml";
+  const std::string args = "train --env catch --task-space " + file +
+                           " --teacher ALP-GMM --algo ppo --envs 2 --checkpoint-every 256 "
+                           "--hp n_steps=64 --hp batch_size=64 --hp pi_layers=16 "
+                           "--hp vf_layers=16 --eval-episodes 0 --save-dir " +
+                           (dir / "run").string();
+  RunResult r = run_cradle(args + " --steps 512");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const fs::path book = dir / "run" / "logs" / "teacher.jsonl";
+  const std::vector<std::string> whole = read_lines(book);
+  const fs::path checkpoints = dir / "run" / "checkpoints";
+  fs::copy_file(checkpoints / "step_256.ckpt", checkpoints / "latest.ckpt",
+                fs::copy_options::overwrite_existing);
+  fs::remove(checkpoints / "final.ckpt");
+
+  r = run_cradle(args + " --steps 512 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("teacher.jsonl: lines after the checkpoint kept in"), std::string::npos)
+      << r.out;
+  // What the first run booked after the checkpoint is kept aside, its dump last.
+  const std::vector<std::string> aside =
+      read_lines(dir / "run" / "logs" / "teacher.after-checkpoint.jsonl");
+  ASSERT_GT(aside.size(), 1u);
+  ASSERT_LT(aside.size(), whole.size());
+  const size_t kept = whole.size() - aside.size();
+  EXPECT_EQ(std::vector<std::string>(whole.begin() + kept, whole.end()), aside);
+  // The book up to the checkpoint, then every later episode once, numbered on, its step count
+  // past the checkpoint's; one teacher dump, at the end.
+  const std::vector<std::string> resumed = read_lines(book);
+  ASSERT_GT(resumed.size(), kept);
+  EXPECT_EQ(std::vector<std::string>(resumed.begin(), resumed.begin() + kept),
+            std::vector<std::string>(whole.begin(), whole.begin() + kept));
+  long train = 0, dumps = 0;
+  for (const std::string& line : resumed) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j["kind"] == "train") {
+      EXPECT_EQ(j["episode"], train++) << line;
+    } else {
+      ++dumps;
+    }
+  }
+  EXPECT_EQ(dumps, 1);
+  const nlohmann::json dump = nlohmann::json::parse(resumed.back());
+  EXPECT_EQ(dump["kind"], "dump");
+  // The teacher counts the steps its envs took: the run's 512 but the autoreset steps, one after
+  // each episode (the last ones of the two envs may have had none).
+  EXPECT_NEAR(dump["env_steps"].get<long>(), 512 - train, 2) << resumed.back();
+}
+
 TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
   const fs::path dir = cradle::test::fresh_dir("train_env_errors");
   const std::string config = cradle::test::config_path("config_selftouch.yml").string();
