@@ -97,6 +97,7 @@ def train(
       `cradle train --help` (ppo, a2c, sac, td3, ddpg, tesac, ccm, satesac, saccm, saccm_all).
     task_space / teacher: a curriculum (a task-space YAML whose teacher sets the env's task
       parameters before every reset; teacher overrides the file's), as --task-space / --teacher.
+      A teacher without task_space sets every task parameter the env declares.
       teacher may also be a Python object with sample_task() and episodic_update(task,
       episode_return, success), optionally dump() and non_exploratory_task_sampling()
       (docs/curricula.md, "A teacher of your own, in Python"): a missing method or a task outside

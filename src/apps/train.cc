@@ -52,7 +52,8 @@ void report_files(const Config& config, const train::TrainOptions& train,
   }
   if (!train.env.empty()) {
     std::printf("logs: %s/logs/progress.csv%s; plots: %s/plots/\n", config.save_dir.c_str(),
-                train.task_space.empty() ? "" : ", teacher.jsonl", config.save_dir.c_str());
+                train.task_space.empty() && train.teacher.empty() ? "" : ", teacher.jsonl",
+                config.save_dir.c_str());
     return;
   }
   std::printf(
@@ -116,7 +117,9 @@ void register_train(CLI::App& app) {
   cmd->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
   cmd->add_option("--task-space", opts->train.task_space,
                   "Curriculum: task-space YAML whose teacher sets the reset options");
-  cmd->add_option("--teacher", opts->train.teacher, "Curriculum teacher (overrides the file's)");
+  cmd->add_option("--teacher", opts->train.teacher,
+                  "Curriculum teacher (overrides the file's); without --task-space it sets every "
+                  "task parameter the env declares (`cradle envs`)");
   cmd->add_option("--eval-episodes", opts->train.eval_episodes, "Evaluation episodes at the end")
       ->check(CLI::Range(0, 100000));
   cmd->add_flag("--compare-random", opts->train.compare_random,

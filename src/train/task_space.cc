@@ -10,7 +10,9 @@
 #include "core/error.h"
 #include "core/jsonl.h"
 #include "teach/registry.h"
+#include "tma/tma_env.h"
 #include "train/run_json.h"
+#include "train/tma_run.h"
 
 namespace cradle::train {
 namespace {
@@ -113,6 +115,32 @@ CurriculumSpec load_task_space(const std::filesystem::path& file, bool need_teac
   return parse_task_space(text.str(), file.string(), need_teacher);
 }
 
+CurriculumSpec env_curriculum(const envs::EnvSpec& env) {
+  if (env.parameters.empty()) {
+    throw UserError("--teacher: " + env.id +
+                    " has no task parameters for a teacher to set (`cradle envs` lists each "
+                    "env's); give --task-space FILE.yml");
+  }
+  CurriculumSpec spec;
+  // TeachMyAgent's benchmark facts are its student runs' (train/tma_run.h).
+  if (env.family == "tma") {
+    const std::string name = env.id.substr(4, env.id.find(':') - 4);
+    const StudentEnv student = tma_student_env(
+        {.env = tma::parse_env_id(name), .body = env.id.substr(env.id.find(':') + 1)});
+    spec.space = student.space;
+    spec.reward_lb = student.reward_lb;
+    spec.reward_ub = student.reward_ub;
+    spec.initial_dist = student.initial_dist;
+    spec.expert_knowledge = "high";
+    return spec;
+  }
+  nlohmann::ordered_json bounds = nlohmann::ordered_json::object();
+  for (const envs::TaskParameter& p : env.parameters) bounds[p.name] = {p.low, p.high};
+  spec.space = teach::TaskSpace::from_json(bounds);
+  spec.env_options.use_score = env.family == "babybench";
+  return spec;
+}
+
 std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
                                                           std::uint64_t seed) {
   teach::TeacherSetup setup{
@@ -125,6 +153,7 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
       .reward_ub = spec.reward_ub,
       .scale_reward = spec.scale_reward,
       .params = spec.teacher_params};
+  setup.initial_dist = spec.initial_dist;
   return make_controller(spec, teach::make_teacher(setup), seed);
 }
 

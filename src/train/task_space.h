@@ -22,7 +22,9 @@
 #include <optional>
 #include <string>
 
+#include "envs/registry.h"
 #include "teach/controller.h"
+#include "teach/registry.h"
 #include "train/curriculum_env.h"
 
 namespace cradle::train {
@@ -35,6 +37,9 @@ struct CurriculumSpec {
   CurriculumOptions env_options;  // the success threshold
   double reward_lb = -100, reward_ub = 100;
   bool scale_reward = false;
+  // The task space's easy region, which teachers start from with high expert knowledge (Stump
+  // Tracks' no-stumps corner); task-space files have none.
+  std::optional<teach::DiagGaussian> initial_dist;
 };
 
 // Parses the YAML text (`source` names it in errors). UserError, one line, for an unknown key,
@@ -43,6 +48,15 @@ struct CurriculumSpec {
 CurriculumSpec parse_task_space(const std::string& yaml_text, const std::string& source,
                                 bool need_teacher = true);
 CurriculumSpec load_task_space(const std::filesystem::path& file, bool need_teacher = true);
+
+// The curriculum of `cradle train --env ID --teacher T` without a task-space file: every task
+// parameter the env declares (envs/registry.h; `cradle envs`), in its declared range, with its
+// family's facts. TeachMyAgent: the benchmark's (return bounds [-150, 350], Parkour 360, Stump
+// Tracks' easy corner, expert knowledge high, as `cradle tma run`); BabyBench: the teacher hears
+// the behaviour score (the env's reward is 0); MIMo and SaMI: the return, success by the env's
+// is_success flag. The teacher's name is left to the run. UserError for an env without task
+// parameters.
+CurriculumSpec env_curriculum(const envs::EnvSpec& env);
 
 // A teacher of the caller's own (e.g. a Python object's, src/python/python_teacher.h) for a task
 // space, seeded by the run; it replaces the file's named teacher.

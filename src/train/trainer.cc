@@ -213,7 +213,6 @@ void check_options(Run& run) {
     if (options.procs < 1) throw UserError("--procs must be at least 1");
     check_procs_split(options.envs, options.procs);
     if (options.async_batch != 0) throw UserError("--procs and --async-batch: give one of them");
-    if (!options.task_space.empty()) throw UserError("--procs is not available with --task-space");
   }
   // An env by id (any family but BabyBench's configs, which train as configs) has none of
   // BabyBench's extras: no training log, start randomisation or final evaluation.
@@ -289,14 +288,25 @@ void check_options(Run& run) {
   // A curriculum: the task space and its teacher (a teacher given by the run needs none named in
   // the file).
   const bool own_teacher = !options.teacher.empty() || options.teacher_factory;
-  if (own_teacher && options.task_space.empty())
-    throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
   if (!options.teacher.empty() && options.teacher_factory)
     throw UserError("a teacher name and a teacher object: give one of them");
   if (!options.task_space.empty()) {
     run.curriculum_spec = load_task_space(options.task_space, /*need_teacher=*/!own_teacher);
-    if (!options.teacher.empty()) run.curriculum_spec->teacher = options.teacher;
+  } else if (own_teacher) {
+    // Without a file, the teacher sets every task parameter the env declares.
+    run.curriculum_spec = env_curriculum(
+        run.by_id ? envs::env_spec(run.env_id)
+                  : envs::EnvSpec{.id = "this BabyBench config",
+                                  .family = "babybench",
+                                  .parameters = envs::babybench_task_parameters(run.config)});
   }
+  if (!options.teacher.empty()) run.curriculum_spec->teacher = options.teacher;
+  // The named teacher is built once here, so that an unknown name or a bad parameter is refused
+  // before --overwrite removes anything.
+  if (run.curriculum_spec && !options.teacher_factory)
+    (void)make_controller(*run.curriculum_spec, options.seed);
+  if (options.procs != 0 && run.curriculum_spec)
+    throw UserError("--procs is not available with a curriculum (--task-space or --teacher)");
   if (run.sync) {
     std::string hp_text;
     for (const auto& [name, value] : run.hyperparameters) hp_text += name + "=" + value + ";";

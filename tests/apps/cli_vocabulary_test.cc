@@ -198,7 +198,7 @@ TEST(CliVocabulary, EveryTrainingCommandSpeaksTheSameFlags) {
   ASSERT_EQ(train.status, 0) << train.out;
   EXPECT_TRUE(fs::exists(dir / "train" / "checkpoints" / "final.ckpt"));
   // A bad curriculum flag is refused before --overwrite removes the run.
-  const std::vector<std::string> bad_flags = {"--teacher ALP-GMM",
+  const std::vector<std::string> bad_flags = {"--teacher NoSuchTeacher",
                                               "--task-space " + (dir / "none.yml").string()};
   for (const std::string& bad : bad_flags) {
     const auto refused =

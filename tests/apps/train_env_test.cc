@@ -137,6 +137,37 @@ TEST(TrainEnv, AResumeCutsTheTeachersBookBackToItsCheckpoint) {
   EXPECT_NEAR(dump["env_steps"].get<long>(), 512 - train, 2) << resumed.back();
 }
 
+// `--teacher` without a task-space file: TeachMyAgent's benchmark curriculum over Stump Tracks,
+// its teacher starting from the easy corner (no stumps, wide spacing) as high expert knowledge has
+// it, within the benchmark's bounds.
+TEST(TrainEnv, ATeacherAloneRunsTheFamilysCurriculum) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_teacher");
+  const RunResult r = run_cradle(
+      "train --env tma/stump-tracks:old_classic_bipedal --teacher ALP-GMM --algo ppo --envs 4 "
+      "--steps 8192 --hp n_steps=256 --hp batch_size=64 --hp pi_layers=16 --hp vf_layers=16 "
+      "--eval-episodes 0 --save-dir " +
+      (dir / "run").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("teacher.jsonl"), std::string::npos) << r.out;
+  long train = 0;
+  for (const std::string& line : read_lines(dir / "run" / "logs" / "teacher.jsonl")) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    if (j["kind"] == "dump") {
+      EXPECT_EQ(j["teacher"]["maxs"], nlohmann::json::parse("[3.0, 6.0]")) << line;
+      continue;
+    }
+    ++train;
+    const auto task = j["task"].get<std::vector<double>>();
+    ASSERT_EQ(task.size(), 2u) << line;
+    EXPECT_GE(task[0], 0.0) << line;  // stump height, near 0
+    EXPECT_LE(task[0], 1.5) << line;
+    EXPECT_GE(task[1], 3.0) << line;  // obstacle spacing, near 6
+    EXPECT_LE(task[1], 6.0) << line;
+  }
+  EXPECT_GE(train, 4);  // each env's first episode, 2,000 steps at most
+  fs::remove_all(dir);
+}
+
 TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
   const fs::path dir = cradle::test::fresh_dir("train_env_errors");
   const std::string config = cradle::test::config_path("config_selftouch.yml").string();
@@ -144,7 +175,7 @@ TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
            "train", "train --env fly", "train --env reach --config " + config,
            "train --env tma/parkour", "train --env reach --randomize-start",
            "train --env reach --compare-random", "train --env reach --no-eval-video",
-           "train --env reach --teacher Random"}) {
+           "train --env standup --teacher Random"}) {
     const RunResult r = run_cradle(args + " --steps 64", dir);
     EXPECT_EQ(r.status, 1) << args << ": " << r.out;
     EXPECT_EQ(r.out.rfind("cradle: error: ", 0), 0u) << args << ": " << r.out;

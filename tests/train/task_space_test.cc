@@ -81,6 +81,42 @@ TEST(TaskSpaceFile, BadFilesAreOneLineErrors) {
   EXPECT_THROW(load_task_space("/nonexistent/space.yml"), UserError);
 }
 
+// Without a file a teacher sets every task parameter the env declares, with its family's facts.
+TEST(EnvCurriculum, EveryDeclaredParameterWithTheFamilysFacts) {
+  // TeachMyAgent: the benchmark's space, return bounds and easy corner (as `cradle tma run`).
+  const CurriculumSpec stumps = env_curriculum(envs::env_spec("tma/stump-tracks:spider"));
+  EXPECT_EQ(stumps.space->dim_names(),
+            (std::vector<std::string>{"stump_height", "obstacle_spacing"}));
+  EXPECT_EQ(stumps.space->maxs(), (std::vector<float>{3, 6}));
+  EXPECT_EQ(stumps.reward_lb, -150);
+  EXPECT_EQ(stumps.reward_ub, 350);
+  EXPECT_EQ(stumps.expert_knowledge, "high");
+  ASSERT_TRUE(stumps.initial_dist);
+  EXPECT_EQ(stumps.initial_dist->mean, (std::vector<float>{0, 6}));
+  const CurriculumSpec parkour = env_curriculum(envs::env_spec("tma/parkour:fish"));
+  EXPECT_EQ(parkour.space->dims(), 8);
+  EXPECT_EQ(parkour.reward_ub, 360);
+  EXPECT_FALSE(parkour.initial_dist);
+  // SaMI: the hidden parameters in the split's ranges; the teacher hears the return.
+  const envs::EnvSpec cheetah = envs::env_spec("sami/HalfCheetah:train");
+  const CurriculumSpec sami = env_curriculum(cheetah);
+  EXPECT_EQ(sami.space->dim_names(), (std::vector<std::string>{"mass", "damping"}));
+  EXPECT_EQ(sami.space->mins()[0], static_cast<float>(cheetah.parameters[0].low));
+  EXPECT_EQ(sami.space->maxs()[1], static_cast<float>(cheetah.parameters[1].high));
+  EXPECT_FALSE(sami.env_options.use_score);
+  EXPECT_EQ(sami.expert_knowledge, "none");
+  // BabyBench's reward is 0: its teacher hears the behaviour score.
+  EXPECT_TRUE(env_curriculum(envs::env_spec("babybench/handregard")).env_options.use_score);
+  // An env without task parameters is a one-line error naming it.
+  try {
+    (void)env_curriculum(envs::env_spec("mimo/standup"));
+    FAIL() << "mimo/standup has no task parameters";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("mimo/standup has no task parameters"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(TaskSpaceFile, ShippedBabyBenchExampleLoads) {
   const CurriculumSpec spec = load_task_space(std::filesystem::path(CRADLE_SOURCE_DIR) /
                                               "configs/curricula/babybench_posture.yml");
