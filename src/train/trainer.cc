@@ -86,11 +86,15 @@ void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& d
                              .y_label = "return",
                              .series = {series(3, "episodic return")}},
               dir / "learning_curve_return.png");
-  figures.add(eval::LinePlot{.title = "Training: behaviour score per episode",
-                             .x_label = "env steps",
-                             .y_label = "score",
-                             .series = {series(5, "behaviour score")}},
-              dir / "learning_curve_score.png");
+  // Only envs that score behaviour (BabyBench's, Panda push's success) have a score chart.
+  eval::Series score = series(5, "behaviour score");
+  if (!score.x.empty()) {
+    figures.add(eval::LinePlot{.title = "Training: behaviour score per episode",
+                               .x_label = "env steps",
+                               .y_label = "score",
+                               .series = {std::move(score)}},
+                dir / "learning_curve_score.png");
+  }
   figures.draw(dir / "figures.json");
 }
 

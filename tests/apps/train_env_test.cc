@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -165,6 +166,11 @@ TEST(TrainEnv, ATeacherAloneRunsTheFamilysCurriculum) {
     EXPECT_LE(task[1], 6.0) << line;
   }
   EXPECT_GE(train, 4);  // each env's first episode, 2,000 steps at most
+  // TeachMyAgent's envs score no behaviour: the return's chart only, no empty score chart.
+  std::ifstream figures(dir / "run" / "plots" / "figures.json");
+  const std::string listed{std::istreambuf_iterator<char>(figures), {}};
+  EXPECT_NE(listed.find("learning_curve_return.png"), std::string::npos) << listed;
+  EXPECT_EQ(listed.find("learning_curve_score"), std::string::npos) << listed;
   fs::remove_all(dir);
 }
 
