@@ -59,8 +59,8 @@ AlgorithmTraits algorithm_traits(std::string_view algorithm) {
   for (const Algorithm& a : kAlgorithms) {
     if (a.name == algorithm) return a.traits;
   }
-  // SaMI's learners train alone (make_sami_learner refuses a sync) and collect lock-step.
-  if (!meta::sami_method(algorithm).empty()) return {};
+  // SaMI's learners train data-parallel and collect lock-step.
+  if (!meta::sami_method(algorithm).empty()) return {.data_parallel = true};
   unknown(algorithm);
 }
 

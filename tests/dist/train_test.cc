@@ -9,6 +9,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "fixture.h"
 #include "ranks.h"
@@ -90,19 +91,36 @@ TEST_P(LaunchById, TwoRanksEndWithBitwiseIdenticalParameters) {
   const auto& [env, algo] = GetParam();
   const fs::path dir = fresh_dir("dist_by_id_" + algo);
   std::string hp = " --hp n_steps=32 batch_size=16 n_epochs=2";
+  int envs = 1;
   if (algo == "sac")
     hp = " --hp learning_starts=16 batch_size=16 buffer_size=2000 report_every=16 "
          "pi_layers=32,32 qf_layers=32,32";
+  // SaCCM contrasts its two training envs' trajectories; 16-step trajectories, so that updates
+  // (and SaNCE's steps) start within the budget.
+  if (algo == "saccm") {
+    envs = 2;
+    hp = " --hp learning_starts=8 batch_size=4 contrast_batch_size=4 buffer_size=50 horizon=16 "
+         "report_every=16 train_freq=16 gradient_steps=2 net_arch=16,16 lstm_hidden=16";
+  }
   const RunResult r =
-      run_cradle("launch --nproc 2 -- cradle train --env " + env + " --algo " + algo +
-                 " --envs 1 --threads 1 --steps 128 --checkpoint-every 64 "
+      run_cradle("launch --nproc 2 -- cradle train --env " + env + " --algo " + algo + " --envs " +
+                 std::to_string(envs) + " --threads 1 --steps " + std::to_string(128 * envs) +
+                 " --checkpoint-every " + std::to_string(64 * envs) +
+                 " "
                  "--seed 5 --dist-timeout 30 --save-dir " +
                  (dir / "run").string() + hp);
   ASSERT_EQ(r.status, 0) << r.out;
   const std::map<int, std::string> h = hashes(r.out);
   ASSERT_EQ(h.size(), 2u) << r.out;
   EXPECT_EQ(h.at(0), h.at(1));
-  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), 128);
+  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), 128 * envs);
+  // SaCCM's ranks updated (critics, actor and SaNCE's steps) before they agreed.
+  if (algo == "saccm") {
+    const std::vector<std::string> rows = read_lines(dir / "run" / "logs" / "progress.csv");
+    ASSERT_GE(rows.size(), 2u);
+    EXPECT_EQ(rows.front().substr(rows.front().rfind(',') + 1), "losses/sance_weight");
+    EXPECT_NE(rows.back().back(), ',') << rows.back();  // the last report's SaNCE weight
+  }
   EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
   fs::remove_all(dir);
 }
@@ -111,7 +129,8 @@ INSTANTIATE_TEST_SUITE_P(
     Families, LaunchById,
     testing::Values(std::pair<std::string, std::string>{"tma/stump-tracks:old_classic_bipedal",
                                                         "ppo"},
-                    std::pair<std::string, std::string>{"sami/CrippleHalfCheetah", "sac"}),
+                    std::pair<std::string, std::string>{"sami/CrippleHalfCheetah", "sac"},
+                    std::pair<std::string, std::string>{"sami/CrippleHalfCheetah", "saccm"}),
     [](const auto& info) { return info.param.second + "_" + std::to_string(info.index); });
 
 TEST(Launch, AFailingRankStopsTheOthersAndIsNamed) {

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "learn/checkpoint.h"
+#include "learn/grad_tensors.h"
 #include "learn/meta/sance.h"
 #include "learn/sac.h"
 
@@ -105,6 +106,16 @@ torch::Tensor steps_at(const torch::Tensor& x, long begin, const torch::Tensor& 
   return x.narrow(0, begin, t).reshape({t * x.size(1), -1}).index_select(0, rows);
 }
 
+// Data-parallel: the gradients an optimiser steps with (the encoder's LSTM, heads and W), averaged
+// over the ranks. A tensor no loss has reached yet has none on every rank alike (every step that
+// reaches one is agreed on), so the ranks reduce the same tensors.
+void average_optimizer_gradients(GradSync* sync, torch::optim::Optimizer& optimizer) {
+  if (!distributed(sync)) return;
+  for (auto& group : optimizer.param_groups()) {
+    for (const torch::Tensor& p : group.params()) average_gradients(sync, p.grad());
+  }
+}
+
 }  // namespace
 
 ContextSac::ContextSac(std::string method, int obs_size, int action_size, const SamiConfig& config,
@@ -170,6 +181,7 @@ ContextSac::Losses ContextSac::update(const TrajectoryReplay& replay, Rng& rng) 
   const torch::Tensor alpha_loss = sac_alpha_loss(log_alpha_, log_pi, target_entropy_);
   alpha_optimizer_.zero_grad();
   alpha_loss.backward();
+  average_gradients(sync_, log_alpha_.grad());
   alpha_optimizer_.step();
 
   // Soft Bellman target at (o_{t+1}, c'_{t+1}).
@@ -189,6 +201,8 @@ ContextSac::Losses ContextSac::update(const TrajectoryReplay& replay, Rng& rng) 
   critic_parameters_.zero_grad();
   encoders_.optimizer.zero_grad();
   critic_loss.backward();
+  average_gradients(sync_, critic_parameters_.tensor().grad());
+  average_optimizer_gradients(sync_, encoders_.optimizer);
   critic_optimizer_.step();
   encoders_.optimizer.step();
 
@@ -201,6 +215,7 @@ ContextSac::Losses ContextSac::update(const TrajectoryReplay& replay, Rng& rng) 
     actor_parameters_.zero_grad();
     actor_loss.backward();
   }
+  average_gradients(sync_, actor_parameters_.tensor().grad());
   actor_optimizer_.step();
   polyak_update(target_parameters_.tensor(), critic_parameters_.tensor(), config_.tau);
 
@@ -210,7 +225,9 @@ ContextSac::Losses ContextSac::update(const TrajectoryReplay& replay, Rng& rng) 
         sample_contrast(contrast_, replay, config_.contrast_batch_size, config_.neg_ratio, rng);
     out.weight =
         sance_weight(config_.adversarial_loss_coef, sample.positive_return, sample.negative_return);
-    if (out.weight > 0) {
+    // Data-parallel: the step runs on every rank when any has a weight (a rank without one adds
+    // a zero gradient to the average).
+    if (agree_max(sync_, out.weight > 0 ? 1.0 : 0.0) > 0) {
       const TrajectoryReplay::Batch positives = replay.gather(sample.positives);
       const TrajectoryReplay::Batch negatives = replay.gather(sample.negatives);
       const torch::Tensor positive_input = positives.encoder_input();
@@ -232,6 +249,7 @@ ContextSac::Losses ContextSac::update(const TrajectoryReplay& replay, Rng& rng) 
                      config_.use_weighted_info_nce ? encoders_.bilinear->weight : torch::Tensor());
       encoders_.optimizer.zero_grad();
       (out.weight * loss).backward();
+      average_optimizer_gradients(sync_, encoders_.optimizer);
       encoders_.optimizer.step();
       out.sance = loss.item<double>();
     }

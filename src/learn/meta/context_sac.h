@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "learn/grad_sync.h"
 #include "learn/hyperparams.h"
 #include "learn/learner.h"
 #include "learn/meta/context_encoder.h"
@@ -110,6 +111,10 @@ class ContextSac {
   ContextEncoder& encoder() { return encoders_.online; }
   EncoderPair& encoders() { return encoders_; }
   at::Generator& generator() { return generator_; }
+  // Data-parallel ranks (null: alone): every gradient is averaged over them before its optimiser
+  // steps, and the contrastive step runs on every rank when it runs on any (learn/grad_sync.h's
+  // contract). The caller keeps `sync` alive and shares rank 0's parameters.
+  void set_sync(GradSync* sync) { sync_ = sync; }
 
   // Sealed checkpoint (learn/checkpoint.h) of everything; `steps` goes into the header.
   void save(const std::filesystem::path& file, long steps) const;
@@ -142,6 +147,7 @@ class ContextSac {
   torch::optim::Adam alpha_optimizer_;
   double target_entropy_;
   long updates_ = 0;
+  GradSync* sync_ = nullptr;
 };
 
 }  // namespace cradle::learn::meta

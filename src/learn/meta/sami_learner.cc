@@ -66,12 +66,6 @@ struct Settings {
 
 // Every setting, parsed strictly from the options; UserError for an unknown name or bad value.
 Settings parse_settings(const std::string& algorithm, const LearnerOptions& options) {
-  // ContextSac steps its optimisers inside its update, with no place to average gradients.
-  if (options.sync) {
-    throw UserError(algorithm +
-                    ": data-parallel training (--distributed) is not available for SaMI's "
-                    "learners; train with one process");
-  }
   apply_torch_options(options);
   Settings settings;
   Hyperparameters table;
@@ -138,6 +132,7 @@ class SamiLearner final : public Learner {
         replay_(envs_, config_.buffer_size, settings_.own.horizon, obs_size_, action_size_),
         rng_(options.seed ^ kRngSalt),
         generator_(at::make_generator<at::CPUGeneratorImpl>(options.seed)),
+        sync_(options.sync),
         stepper_(env, options.reward_hook),
         streams_(sac_.streams(envs_)),
         act_stream_(sac_.streams(1)),
@@ -156,6 +151,9 @@ class SamiLearner final : public Learner {
       high_.push_back(box.high[j]);
       scale_.push_back(0.5 * (box.high[j] - box.low[j]));
     }
+    // Data-parallel: every rank starts from rank 0's networks and averages its gradients.
+    sac_.set_sync(sync_.get());
+    for (const torch::Tensor& p : sac_.parameters()) broadcast_tensor(sync_.get(), p.detach());
   }
 
   std::string_view algorithm() const override { return algorithm_; }
@@ -196,6 +194,13 @@ class SamiLearner final : public Learner {
           vector_steps_ = vector_steps.item<long>();
         });
     steps_ = info.steps;
+    // Data-parallel: every rank loaded rank 0's generators; ranks above 0 go on with streams of
+    // their own, so that they explore and sample differently.
+    if (distributed(sync_.get()) && sync_->rank() > 0) {
+      offset_generator(sync_.get(), generator_);
+      offset_generator(sync_.get(), sac_.generator());
+      rng_ = Rng(rng_.next() ^ (0x9e3779b97f4a7c15ULL * static_cast<unsigned>(sync_->rank())));
+    }
     new_episode();
   }
 
@@ -283,8 +288,9 @@ class SamiLearner final : public Learner {
   const int envs_, obs_size_, action_size_;
   ContextSac sac_;
   TrajectoryReplay replay_;
-  Rng rng_;                  // random actions, replay samples
-  at::Generator generator_;  // env seeds
+  Rng rng_;                         // random actions, replay samples
+  at::Generator generator_;         // env seeds
+  std::shared_ptr<GradSync> sync_;  // data-parallel ranks (null: alone)
   EnvStepper stepper_;
   ContextSac::Streams streams_, act_stream_;
   torch::Tensor observations_;       // [envs, obs] float32: the current observations
@@ -306,7 +312,9 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
   if (steps_ >= total_steps) return;
   const Clock::time_point start = Clock::now();
   const long start_steps = steps_;
+  // learning_starts counts this rank's env steps; steps_ every rank's (as SAC's).
   const long random_steps = config_.learning_starts * envs_;
+  const long ranks = world_size(sync_.get());
   const int horizon = settings_.own.horizon;
   records_.clear();
   new_episode();
@@ -326,7 +334,7 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
     // learning_starts the actions taken are uniform and replace the streams' previous actions.
     const torch::Tensor policy = sac_.act(observations_, streams_, /*deterministic=*/false).first;
     float* taken = streams_.prev_actions.data_ptr<float>();
-    if (steps_ < random_steps) {
+    if (vector_steps_ * envs_ < random_steps) {
       for (size_t k = 0; k < actions_.size(); ++k) {
         actions_[k] = rng_.uniform(-1.0, 1.0);
         taken[k] = static_cast<float>(actions_[k]);
@@ -338,7 +346,7 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
     rescale(actions_.data(), env_actions_);
     stepper_.step(env_actions_);
     ++vector_steps_;
-    steps_ += envs_;
+    steps_ += envs_ * ranks;
 
     // Store: a slot reset by this step starts a trajectory; the others extend theirs.
     const std::span<const std::uint8_t> real = stepper_.real();
@@ -372,10 +380,12 @@ void SamiLearner::learn(long total_steps, const ProgressFn& on_progress) {
     }
 
     // Train every train_freq vector steps once past learning_starts with a whole trajectory in
-    // every slot.
-    bool ready = steps_ >= random_steps;
-    for (int i = 0; i < envs_ && ready; ++i) ready = replay_.stored(i) > 0;
-    if (ready && vector_steps_ % config_.train_freq == 0) train();
+    // every slot; data-parallel, on every rank when every rank has them (so updates pair up).
+    if (vector_steps_ * envs_ >= random_steps && vector_steps_ % config_.train_freq == 0) {
+      bool ready = true;
+      for (int i = 0; i < envs_ && ready; ++i) ready = replay_.stored(i) > 0;
+      if (agree_max(sync_.get(), ready ? 0.0 : 1.0) == 0.0) train();
+    }
 
     if (vector_steps_ % settings_.own.report_every != 0 && steps_ < total_steps) continue;
     const TrainStats stats = report(start, start_steps);

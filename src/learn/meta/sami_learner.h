@@ -46,7 +46,15 @@
 //
 // act() keeps one context stream: its calls are one episode's consecutive steps until
 // new_episode(), a learn() or load() call, or `horizon` calls (the longest context the encoder is
-// trained on). value() is NaN. Data-parallel training (LearnerOptions::sync) is refused.
+// trained on). value() is NaN.
+//
+// Data-parallel (LearnerOptions::sync, `--distributed`): every rank starts from rank 0's networks,
+// collects on its own envs into its own rings, and averages every gradient (temperature, critics
+// with the encoder, actor, the contrastive step) before its optimiser steps; updates start when
+// every rank holds a whole trajectory in every slot, and the contrastive step runs on every rank
+// when any rank's batch gives it a weight. steps() counts every rank's env steps (as SAC's);
+// learning_starts counts a rank's own. A resumed rank loads rank 0's checkpoint, rings included,
+// and draws from generators of its own from there.
 #pragma once
 
 #include <memory>
@@ -70,9 +78,9 @@ std::span<const std::string_view> sami_learner_names();
 // ContextSac's method of a learner name ("saccm" -> "SaCCM"); "" for another name.
 std::string_view sami_method(std::string_view algorithm);
 
-// Throws UserError for an unknown algorithm or hyperparameter, a bad value, a non-null sync, an
-// env with uint8 (image) observation keys or no float ones, an action space without finite
-// bounds, CCM on fewer than two envs, or a replay too large for the machine.
+// Throws UserError for an unknown algorithm or hyperparameter, a bad value, an env with uint8
+// (image) observation keys or no float ones, an action space without finite bounds, CCM on fewer
+// than two envs, or a replay too large for the machine.
 std::unique_ptr<Learner> make_sami_learner(std::string_view algorithm, VecEnv& env,
                                            const LearnerOptions& options);
 

@@ -83,15 +83,16 @@ TEST(SamiLearner, RegistryListsAndBuildsEveryAlgorithm) {
 }
 
 // The run asks the registry which algorithms train data-parallel or collect asynchronously;
-// SaMI's context learners do neither.
+// SaMI's context learners train data-parallel and collect lock-step.
 TEST(SamiLearner, RegistryTellsWhatEachAlgorithmCanDo) {
-  EXPECT_EQ(algorithms_with(&AlgorithmTraits::data_parallel), "ppo, a2c or sac");
+  EXPECT_EQ(algorithms_with(&AlgorithmTraits::data_parallel),
+            "ppo, a2c, sac, tesac, ccm, satesac, saccm or saccm_all");
   EXPECT_EQ(algorithms_with(&AlgorithmTraits::async_collection, "and"), "ppo and a2c");
   EXPECT_TRUE(algorithm_traits("sac").data_parallel);
   EXPECT_FALSE(algorithm_traits("sac").async_collection);
   EXPECT_FALSE(algorithm_traits("td3").data_parallel);
   for (const std::string_view name : sami_learner_names()) {
-    EXPECT_FALSE(algorithm_traits(name).data_parallel) << name;
+    EXPECT_TRUE(algorithm_traits(name).data_parallel) << name;
     EXPECT_FALSE(algorithm_traits(name).async_collection) << name;
   }
   const std::string error = user_error([] { algorithm_traits("dqn"); });
@@ -262,16 +263,6 @@ TEST(SamiLearner, NextStepAutoresetStoresEachEpisodeOnceWithTheHookedRewards) {
   EXPECT_GT(last.losses.at("updates"), 0);
 }
 
-class TwoRanks final : public GradSync {
- public:
-  int rank() const override { return 0; }
-  int world_size() const override { return 2; }
-  void all_reduce_sum(std::span<float>) override {}
-  void all_reduce_sum(std::span<double>) override {}
-  void all_reduce_max(std::span<double>) override {}
-  void broadcast(std::span<float>) override {}
-};
-
 TEST(SamiLearner, RefusalsAreOneLineUserErrors) {
   auto vec = sami_envs(2, 1);
   const auto refused = [&](const std::string& algorithm, VecEnv& env,
@@ -286,7 +277,6 @@ TEST(SamiLearner, RefusalsAreOneLineUserErrors) {
   refused("saccm", *vec, {.hyperparameters = {{"horizon", "0"}}});
   refused("saccm", *vec, {.hyperparameters = {{"train_freq", "0"}}});
   refused("saccm", *vec, {.hyperparameters = {{"neg_ratio", "2"}}});
-  refused("saccm", *vec, {.sync = std::make_shared<TwoRanks>()});
   auto one = sami_envs(1, 1);
   refused("ccm", *one, {});
   // An image key.
