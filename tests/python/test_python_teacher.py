@@ -179,3 +179,21 @@ def test_resume_replays_the_booked_episodes_into_the_teacher(tmp_path, space):
     assert [u[1] for u in fresh.updates[:len(booked)]] == pytest.approx(
         [e["return"] for e in booked], rel=1e-12, abs=1e-12)
     assert len(fresh.handed) > len(booked)
+
+
+def test_without_a_task_space_the_teacher_sets_every_parameter_the_env_declares(tmp_path):
+    # Stump Tracks declares stump_height [0, 3] and obstacle_spacing [0, 6]: the same box as the
+    # file's, so the Python teacher's tasks fit it.
+    teacher = Counting()
+    cradle.train(env=ENV, algo="ppo", steps=3000, envs=2, hyperparameters=PPO, teacher=teacher,
+                 save_dir=tmp_path / "run", progress_bar=False)
+    with open(tmp_path / "run" / "logs" / "teacher.jsonl") as f:
+        lines = [json.loads(line) for line in f]
+    assert lines[-1]["teacher"]["mins"] == [0, 0]
+    assert lines[-1]["teacher"]["maxs"] == [3, 6]
+    assert len([e for e in lines if e["kind"] == "train"]) == len(teacher.updates) >= 2
+    # An env without task parameters is a ValueError naming it, and nothing is written.
+    with pytest.raises(ValueError, match="mimo/standup has no task parameters"):
+        cradle.train(env="mimo/standup", algo="ppo", steps=64, teacher="Random",
+                     save_dir=tmp_path / "standup", progress_bar=False)
+    assert not (tmp_path / "standup").exists()
