@@ -12,7 +12,6 @@
 #include <string_view>
 #include <vector>
 
-#include "core/config.h"
 #include "core/spaces.h"
 #include "envs/info.h"
 

@@ -18,7 +18,6 @@
 #include <thread>
 #include <vector>
 
-#include "core/config.h"
 #include "core/thread_pool.h"
 #include "learn/vec_env.h"
 
