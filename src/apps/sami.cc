@@ -19,6 +19,7 @@
 #include "apps/bench_report.h"
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/distributed_flags.h"
 #include "apps/interrupt.h"
 #include "core/error.h"
 #include "core/folders.h"
@@ -152,6 +153,7 @@ void random_episodes(const std::string& name, const std::string& split, int epis
 void register_learners(CLI::App& cmd) {
   struct Options {
     train::SamiTrainOptions train;
+    DistributedFlags dist;
     std::vector<std::string> hp;
     std::string out;
     train::SamiEvalOptions eval;
@@ -187,6 +189,7 @@ void register_learners(CLI::App& cmd) {
                  "Env steps per training env between checkpoints")
       ->check(CLI::Range(1L, 10'000'000'000L));
   tr->add_flag("!--no-progress", opts->train.progress_bar, "No progress bar");
+  add_distributed_flags(tr, opts->dist);
   tr->callback([opts, tr] {
     // --resume --out DIR continues DIR's env, method and seed (its run.json): one left out is the
     // run's, one given must be the run's (sami_train refuses another env or method, the seed is
@@ -210,15 +213,26 @@ void register_learners(CLI::App& cmd) {
     opts->train.hyperparameters = learn::parse_hyperparameter_flags(opts->hp);
     opts->train.out = opts->out;
     opts->train.stop = stop_on({SIGINT, SIGTERM});
-    const train::SamiTrainResult r = train::sami_train(opts->train);
-    std::printf(
-        "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "
-        "last return %.3f\ncheckpoint: %s\n",
-        r.run.string().c_str(), r.steps, r.updates, r.sps, r.gradient_steps_per_s, r.last_return,
-        r.checkpoint.string().c_str());
+    train::SamiTrainResult r;
+    const int rank = run_as_rank(opts->dist, [&](std::shared_ptr<learn::GradSync> sync) {
+      opts->train.sync = std::move(sync);
+      r = train::sami_train(opts->train);
+      opts->train.sync.reset();  // the ranks' group ends with this call
+      return r.parameter_hash;
+    });
+    // Rank 0 reports the run; a stopped rank exits 130.
+    if (rank == 0) {
+      std::printf(
+          "%s: %ld env steps, %ld gradient steps, %.0f env steps/s, %.2f gradient steps/s, "
+          "last return %.3f\ncheckpoint: %s\n",
+          r.run.string().c_str(), r.steps, r.updates, r.sps, r.gradient_steps_per_s, r.last_return,
+          r.checkpoint.string().c_str());
+    }
     if (r.stopped) {
-      std::printf("stopped by a signal; continue with: cradle sami train --out %s --resume\n",
-                  r.run.string().c_str());
+      if (rank == 0) {
+        std::printf("stopped by a signal; continue with: cradle sami train --out %s --resume\n",
+                    r.run.string().c_str());
+      }
       throw Stopped{};  // exit 130
     }
   });

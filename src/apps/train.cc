@@ -12,14 +12,13 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/distributed_flags.h"
 #include "apps/interrupt.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "dist/process_group.h"
 #include "envs/registry.h"
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
-#include "train/dist_sync.h"
 #include "train/trainer.h"
 
 namespace cradle::apps {
@@ -70,8 +69,7 @@ void register_train(CLI::App& app) {
     cradle::train::TrainOptions train;
     std::vector<std::string> hp;
     bool no_eval = false;
-    bool distributed = false;
-    dist::RendezvousFlags rendezvous;
+    DistributedFlags dist;
   };
   auto opts = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("train", "Train a policy with intrinsic motivation");
@@ -127,23 +125,8 @@ void register_train(CLI::App& app) {
   cmd->add_flag(
       "--no-eval-video", [opts](std::int64_t) { opts->train.eval_render = false; },
       "Evaluate without writing videos");
-  // Data-parallel training (docs/distributed.md): under `cradle launch`, torchrun-style
-  // variables, `srun`, or these flags.
-  CLI::Option* distributed = cmd->add_flag(
-      "--distributed", opts->distributed,
-      "Data-parallel over ranks (WORLD_SIZE/RANK/MASTER_ADDR/MASTER_PORT or Slurm's variables)");
-  cmd->add_option("--world-size", opts->rendezvous.world_size, "Ranks in all (with --distributed)")
-      ->check(CLI::Range(1, 1 << 20))
-      ->needs(distributed);
-  cmd->add_option("--rank", opts->rendezvous.rank, "This process's rank (with --distributed)")
-      ->check(CLI::Range(0, 1 << 20))
-      ->needs(distributed);
-  cmd->add_option("--master", opts->rendezvous.master, "Rank 0's host[:port] (with --distributed)")
-      ->needs(distributed);
-  cmd->add_option("--dist-timeout", opts->rendezvous.timeout_seconds,
-                  "Seconds to wait for the other ranks before failing")
-      ->check(CLI::Range(1, 86400))
-      ->needs(distributed);
+  // Data-parallel training (docs/distributed.md).
+  add_distributed_flags(cmd, opts->dist);
   cmd->callback([opts, cmd] {
     // --resume continues the checkpoint's algorithm; an --algo that contradicts it is refused.
     if (opts->train.resume && cmd->get_option("--algo")->count() == 0) {
@@ -181,29 +164,18 @@ void register_train(CLI::App& app) {
     // Ctrl-C, or SIGTERM from srun, `cradle launch` or a scheduler's time limit, ends the run at
     // its next update with a checkpoint.
     opts->train.stop = stop_on({SIGINT, SIGTERM});
-    std::unique_ptr<dist::ProcessGroup> group;
-    if (opts->distributed) {
-      group = std::make_unique<dist::ProcessGroup>(
-          dist::resolve_rendezvous(opts->rendezvous, dist::process_env()));
-      opts->train.sync = std::make_shared<train::DistSync>(*group);
-    }
     train::TrainResult r;
-    try {
+    const int rank = run_as_rank(opts->dist, [&](std::shared_ptr<learn::GradSync> sync) {
+      opts->train.sync = std::move(sync);
       r = train::train(config, opts->train);
-    } catch (const std::exception& e) {
-      if (group) group->announce_failure(e.what());  // the other ranks name this one
-      throw;
-    }
-    if (group) {
-      std::printf("rank %d of %d: parameter hash %016llx; %ld collectives, %.2f s\n", group->rank(),
-                  group->world_size(), static_cast<unsigned long long>(r.parameter_hash),
-                  group->collectives(), group->collective_seconds());
-    }
+      opts->train.sync.reset();  // the ranks' group ends with this call
+      return r.parameter_hash;
+    });
     const bool stopped = opts->train.stop->load();
     std::printf("trained %ld env steps in %.0f s (%.0f steps/s)%s\n", r.steps, r.seconds,
                 r.steps_per_second, stopped ? " — interrupted" : "");
     // Rank 0 reports the run's files; a stopped run then exits 130, not 0.
-    if (!group || group->rank() == 0) report_files(config, opts->train, r);
+    if (rank == 0) report_files(config, opts->train, r);
     if (stopped) throw Stopped{};
   });
 }

@@ -133,6 +133,29 @@ INSTANTIATE_TEST_SUITE_P(
                     std::pair<std::string, std::string>{"sami/CrippleHalfCheetah", "saccm"}),
     [](const auto& info) { return info.param.second + "_" + std::to_string(info.index); });
 
+// `cradle sami train`, SaMI's own command, takes --distributed too: each rank its own three
+// training envs, one SaCCM with the same networks on both ranks at the end, rank 0 writing the run.
+TEST(LaunchSami, SamiTrainTwoRanksEndWithBitwiseIdenticalParameters) {
+  const fs::path dir = fresh_dir("dist_sami_train");
+  const RunResult r = run_cradle(
+      "launch --nproc 2 -- cradle sami train --env CrippleHalfCheetah --method SaCCM --seed 3 "
+      "--steps 384 --checkpoint-every 32 --distributed --dist-timeout 30 --no-progress --out " +
+      (dir / "run").string() +
+      " --hp learning_starts=8 --hp batch_size=4 --hp contrast_batch_size=4 --hp buffer_size=50 "
+      "--hp horizon=16 --hp report_every=16 --hp train_freq=16 --hp gradient_steps=2 "
+      "--hp net_arch=16,16 --hp lstm_hidden=16");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::map<int, std::string> h = hashes(r.out);
+  ASSERT_EQ(h.size(), 2u) << r.out;
+  EXPECT_EQ(h.at(0), h.at(1));
+  // The budget counts both ranks' env steps; only rank 0 reports the run.
+  EXPECT_EQ(last_step(dir / "run" / "logs" / "progress.csv"), 384);
+  EXPECT_NE(r.out.find("384 env steps, 8 gradient steps"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("checkpoint:"), r.out.rfind("checkpoint:")) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
+  fs::remove_all(dir);
+}
+
 TEST(Launch, AFailingRankStopsTheOthersAndIsNamed) {
   const auto start = std::chrono::steady_clock::now();
   const RunResult r = run_cradle(

@@ -231,17 +231,20 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
                      .eval_episodes = 0,
                      .progress_bar = options.progress_bar,
                      .stop = options.stop,
-                     .on_report = [&](const learn::TrainStats& s) {
-                       const auto loss = [&](const char* key) {
-                         const auto it = s.losses.find(key);
-                         return it == s.losses.end() ? 0.0 : it->second;
-                       };
-                       result.updates = static_cast<long>(loss("updates"));
-                       window_updates += static_cast<long>(loss("gradient_steps"));
-                       update_seconds += loss("update_seconds");
-                       if (s.episodes > 0) result.last_return = s.episodic_return;
-                     }});
+                     .on_report =
+                         [&](const learn::TrainStats& s) {
+                           const auto loss = [&](const char* key) {
+                             const auto it = s.losses.find(key);
+                             return it == s.losses.end() ? 0.0 : it->second;
+                           };
+                           result.updates = static_cast<long>(loss("updates"));
+                           window_updates += static_cast<long>(loss("gradient_steps"));
+                           update_seconds += loss("update_seconds");
+                           if (s.episodes > 0) result.last_return = s.episodic_return;
+                         },
+                     .sync = options.sync});
   result.steps = trained.steps;
+  result.parameter_hash = trained.parameter_hash;
   result.sps = trained.steps_per_second;
   result.gradient_steps_per_s = update_seconds > 0 ? window_updates / update_seconds : 0;
   result.stopped = options.stop && options.stop->load() && result.steps < steps_per_env * envs;

@@ -14,9 +14,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "learn/grad_sync.h"
 #include "sami/task.h"
 
 namespace cradle::train {
@@ -49,6 +51,9 @@ struct SamiTrainOptions {
   // Set (e.g. by Ctrl-C) to stop at the next progress row with a checkpoint, so that --resume
   // continues from there.
   const std::atomic<bool>* stop = nullptr;
+  // A data-parallel run's ranks (TrainOptions::sync): each rank its own training envs, the
+  // gradients averaged; the budget counts every rank's env steps. Null: this process alone.
+  std::shared_ptr<learn::GradSync> sync;
 };
 
 struct SamiTrainResult {
@@ -60,6 +65,7 @@ struct SamiTrainResult {
   double last_return = 0;            // mean return of the episodes of the last report
   bool stopped = false;              // ended by `stop` before the budget
   std::filesystem::path checkpoint;  // checkpoints/final.ckpt
+  std::uint64_t parameter_hash = 0;  // of the trained networks (the ranks compare it)
 };
 SamiTrainResult sami_train(const SamiTrainOptions& options);
 
