@@ -25,8 +25,8 @@ constexpr Algorithm kAlgorithms[] = {
     {"ppo", make_ppo, {.data_parallel = true, .async_collection = true}},
     {"a2c", make_a2c, {.data_parallel = true, .async_collection = true}},
     {"sac", make_sac, {.data_parallel = true}},
-    {"td3", make_td3, {}},
-    {"ddpg", make_ddpg, {}},
+    {"td3", make_td3, {.data_parallel = true}},
+    {"ddpg", make_ddpg, {.data_parallel = true}},
 };
 
 // "a, b, c <last> d".

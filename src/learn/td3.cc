@@ -7,11 +7,14 @@
 //     J(mu) = -mean(Q_1(s, mu(s)))                      one Adam step on the actor
 //     Q' <- tau Q + (1 - tau) Q',  mu' <- tau mu + (1 - tau) mu'
 // Exploration: a = clip(mu(s) + N(0, exploration_noise), -1, 1).
+// Data-parallel (learn/grad_sync.h): the critics' and the actor's gradients are averaged over the
+// ranks before their Adam steps; the delay counts updates, which every rank makes alike.
 #include "learn/td3.h"
 
 #include <torch/torch.h>
 
 #include "core/error.h"
+#include "learn/grad_tensors.h"
 
 namespace cradle::learn {
 
@@ -166,6 +169,7 @@ class Td3 final : public OffPolicyLearner {
     const torch::Tensor qf_loss = q_losses.sum();
     critic_parameters_.zero_grad();
     qf_loss.backward();
+    average_gradients(sync(), critic_parameters_.tensor().grad());
     critic_optimizer_.step();
     record("qf_loss", qf_loss.item<double>());
     record("qf1_loss", q_losses[0].item<double>());
@@ -180,6 +184,7 @@ class Td3 final : public OffPolicyLearner {
       actor_parameters_.zero_grad();
       actor_loss.backward();
     }
+    average_gradients(sync(), actor_parameters_.tensor().grad());
     actor_optimizer_.step();
     polyak_update(critic_target_parameters_.tensor(), critic_parameters_.tensor(), loop_.tau);
     polyak_update(actor_target_parameters_.tensor(), actor_parameters_.tensor(), loop_.tau);

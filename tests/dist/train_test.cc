@@ -28,7 +28,7 @@ std::string quick_config(const fs::path& dir) {
 std::string train_args(const fs::path& dir, const std::string& algo, long steps) {
   std::string hp = " --hp n_steps=32 batch_size=16 n_epochs=2";
   if (algo == "a2c") hp = " --hp n_steps=8";
-  if (algo == "sac") {
+  if (algo == "sac" || algo == "td3" || algo == "ddpg") {
     hp = " --hp learning_starts=16 batch_size=16 buffer_size=2000 report_every=16 pi_layers=32,32"
          " qf_layers=32,32";
   }
@@ -81,7 +81,7 @@ TEST_P(Launch, TwoRanksEndWithBitwiseIdenticalParameters) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Learners, Launch, testing::Values("ppo", "a2c", "sac"));
+INSTANTIATE_TEST_SUITE_P(Learners, Launch, testing::Values("ppo", "a2c", "sac", "td3", "ddpg"));
 
 // Every env family trains data-parallel through the same run: TeachMyAgent and SaMI by id, 2 ranks,
 // the same parameters on both at the end.

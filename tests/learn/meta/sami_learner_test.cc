@@ -86,11 +86,11 @@ TEST(SamiLearner, RegistryListsAndBuildsEveryAlgorithm) {
 // SaMI's context learners train data-parallel and collect lock-step.
 TEST(SamiLearner, RegistryTellsWhatEachAlgorithmCanDo) {
   EXPECT_EQ(algorithms_with(&AlgorithmTraits::data_parallel),
-            "ppo, a2c, sac, tesac, ccm, satesac, saccm or saccm_all");
+            "ppo, a2c, sac, td3, ddpg, tesac, ccm, satesac, saccm or saccm_all");
   EXPECT_EQ(algorithms_with(&AlgorithmTraits::async_collection, "and"), "ppo and a2c");
   EXPECT_TRUE(algorithm_traits("sac").data_parallel);
   EXPECT_FALSE(algorithm_traits("sac").async_collection);
-  EXPECT_FALSE(algorithm_traits("td3").data_parallel);
+  EXPECT_TRUE(algorithm_traits("td3").data_parallel);
   for (const std::string_view name : sami_learner_names()) {
     EXPECT_TRUE(algorithm_traits(name).data_parallel) << name;
     EXPECT_FALSE(algorithm_traits(name).async_collection) << name;
