@@ -32,6 +32,7 @@
 #include "learn/registry.h"
 #include "learn/vector_env.h"
 #include "teach/registry.h"
+#include "tma/physics.h"
 #include "tma/render.h"
 #include "train/run_json.h"
 
@@ -374,8 +375,8 @@ void video(const VideoOptions& o) {
   writer.write(frame);
   writer.close();
   std::printf("test task %d: return %.1f in %d steps (%s) after %ld training steps -> %s\n",
-              o.test_task, ret, length, ret > 230 ? "mastered" : "not mastered", info.steps,
-              out.c_str());
+              o.test_task, ret, length, ret > tma::kSuccessReturn ? "mastered" : "not mastered",
+              info.steps, out.c_str());
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "learn/learner.h"
 #include "teach/controller.h"
 #include "teach/registry.h"
+#include "tma/physics.h"
 #include "tma/tma_env.h"
 
 namespace cradle::train {
@@ -31,7 +32,7 @@ struct StudentEnv {
   std::function<std::unique_ptr<envs::Env>()> make;  // a fresh env (training or test)
   teach::TaskSpace space;
   double reward_lb = -100, reward_ub = 100;         // return bounds for reward scaling
-  double success_threshold = 230;                   // return above which a task is mastered
+  double success_threshold = tma::kSuccessReturn;   // return above which a task is mastered
   std::optional<teach::DiagGaussian> initial_dist;  // the easy region (high expert knowledge)
   std::vector<teach::Task> test_set;                // empty: teach::default_test_set
 };
