@@ -34,6 +34,7 @@
 #include "teach/registry.h"
 #include "tma/physics.h"
 #include "tma/render.h"
+#include "train/episodes.h"
 #include "train/run_json.h"
 
 extern char** environ;
@@ -352,30 +353,31 @@ void video(const VideoOptions& o) {
 
   envs::TmaEnvAdapter env(options);
   env.set_reset_options(task);
-  env.reset(o.seed);
   const std::string out =
       o.out.empty() ? (dir / ("test_task_" + std::to_string(o.test_task) + ".mp4")).string()
                     : o.out;
   const int w = 600, h = 400;
   eval::VideoWriter writer(out, w, h, tma::kFps);
   std::vector<std::uint8_t> frame;
-  std::vector<double> action(env.action_space().size());
-  double ret = 0;
-  int length = 0;
-  for (bool done = false; !done;) {
-    tma::render(env.env(), w, h, o.lidars, frame);
-    writer.write(frame);
-    learner->act(env.observation(), action, /*deterministic=*/true);
-    const envs::StepResult r = env.step(action);
-    ret += r.reward;
-    ++length;
-    done = r.terminated || r.truncated;
-  }
+  // The one evaluation rollout; a frame of the state each action sees, then of the last state.
+  const std::uint64_t seed = o.seed;
+  const train::EpisodeOutcome episode =
+      train::run_episodes(
+          env,
+          {.act =
+               [&](const envs::ObservationBuffers& observation, std::span<double> action) {
+                 tma::render(env.env(), w, h, o.lidars, frame);
+                 writer.write(frame);
+                 learner->act(observation, action, /*deterministic=*/true);
+               }},
+          std::span(&seed, 1))
+          .front();
   tma::render(env.env(), w, h, o.lidars, frame);
   writer.write(frame);
   writer.close();
   std::printf("test task %d: return %.1f in %d steps (%s) after %ld training steps -> %s\n",
-              o.test_task, ret, length, ret > tma::kSuccessReturn ? "mastered" : "not mastered",
+              o.test_task, episode.episode_return, episode.length,
+              episode.episode_return > tma::kSuccessReturn ? "mastered" : "not mastered",
               info.steps, out.c_str());
 }
 
