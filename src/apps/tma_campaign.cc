@@ -45,12 +45,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A teacher parameter as `cradle tma run --teacher-param k=v` reads it: JSON when it parses, else
-// a string.
-nlohmann::json param_value(const std::string& v) {
-  return nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
-}
-
 // Teachers that refuse to run without expert knowledge (spec §1.3).
 const std::set<std::string> kNeedExpertKnowledge = {"ADR", "GoalGAN", "Setter-Solver"};
 
@@ -76,17 +70,10 @@ void check_teacher(const std::string& where, const std::string& teacher,
   setup.name = teacher;
   setup.mins = {0, 0};
   setup.maxs = {1, 1};
-  for (const std::string& p : params) {
-    const size_t eq = p.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      throw UserError(where + ": --teacher-param '" + shown(p) + "' (expected key=value)");
-    }
-    const std::string key = p.substr(0, eq);
-    if (setup.params.contains(key)) {
-      throw UserError(where + ": --teacher-param " + shown(key) +
-                      " is given twice (expected each key once)");
-    }
-    setup.params[key] = param_value(p.substr(eq + 1));
+  try {
+    setup.params = teach::parse_teacher_params(params);
+  } catch (const UserError& e) {
+    throw UserError(where + ": " + e.what());
   }
   // Built once per teacher, parameters and level (a campaign file repeats them on every line).
   static std::set<std::string> checked;

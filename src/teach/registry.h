@@ -20,6 +20,12 @@ enum class ExpertKnowledge { none, low, high };
 
 // "none" or "no", "low", "high"; anything else throws UserError.
 ExpertKnowledge parse_expert_knowledge(std::string_view text);
+
+// `--teacher-param key=value` flags as a teacher's parameters (TeacherSetup::params), each value
+// as JSON when it parses as JSON, else as a string. UserError naming the flag (control characters
+// shown as \xNN, so the message stays one line) for one without a key or '=', and for a key given
+// twice, whose first value would be dropped.
+nlohmann::json parse_teacher_params(const std::vector<std::string>& flags);
 // "none", "low" or "high".
 const char* expert_knowledge_name(ExpertKnowledge ek);
 

@@ -624,15 +624,6 @@ StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& o) 
 
 namespace {
 
-// "k=v" -> (k, v) or a one-line error naming the flag.
-std::pair<std::string, std::string> key_value(const std::string& flag, const std::string& text) {
-  const size_t eq = text.find('=');
-  if (eq == std::string::npos || eq == 0) {
-    throw UserError(flag + " '" + text + "': expected name=value");
-  }
-  return {text.substr(0, eq), text.substr(eq + 1)};
-}
-
 // Whether the run folder's run.json records body or Parkour options.
 bool run_has_env_options(const fs::path& dir) {
   // Only a readable file counts; the resume itself names a damaged one.
@@ -681,10 +672,7 @@ TmaRun run_tma(const TmaRunArguments& a) {
                       .resume = a.resume,
                       .overwrite = a.overwrite,
                       .progress_bar = a.progress_bar};
-  for (const std::string& kv : a.teacher_params) {
-    const auto [k, v] = key_value("--teacher-param", kv);
-    o.teacher_params[k] = nlohmann::json::accept(v) ? nlohmann::json::parse(v) : nlohmann::json(v);
-  }
+  o.teacher_params = teach::parse_teacher_params(a.teacher_params);
   o.hyperparameters = learn::parse_hyperparameter_flags(a.hp);
   // learning_rate with --lr would keep only one value, silently.
   if (a.lr != 0 && !o.hyperparameters.emplace("learning_rate", std::to_string(a.lr)).second)

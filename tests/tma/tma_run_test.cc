@@ -348,7 +348,8 @@ TEST(TmaRun, BadInputIsAOneLineError) {
   for (const char* bad :
        {"--student dqn", "--teacher Teacherless", "--teacher ADR --allow_expert_knowledge none",
         "--allow_expert_knowledge some", "--nb_env_steps -1", "--test_set no_such_set",
-        "--embodiment tripod", "--teacher-param fit_rat=3", "--hp n_stepz=3"}) {
+        "--embodiment tripod", "--teacher-param fit_rat=3", "--hp n_stepz=3",
+        "--teacher-param fit_rate=2 --teacher-param fit_rate=3", "--teacher-param fit_rate"}) {
     const RunResult r =
         run_cradle("tma run --no-progress --out " + dir.string() + " " + std::string(bad));
     EXPECT_EQ(r.status, 1) << bad << ": " << r.out;
