@@ -128,7 +128,7 @@ std::vector<std::string> sami_env_names() {
   std::vector<std::string> names;
   for (const envs::EnvSpec& s : envs::env_specs()) {
     if (s.family != "sami" || !s.id.starts_with("sami/")) continue;
-    const std::string env = s.id.substr(5, s.id.find(':') - 5);
+    const std::string env = envs::split_env_id(s.id).name;
     if (std::find(names.begin(), names.end(), env) == names.end()) names.push_back(env);
   }
   return names;

@@ -20,6 +20,19 @@
 #include "tma/tma_env.h"
 
 namespace cradle::envs {
+
+EnvIdParts split_env_id(std::string_view id) {
+  EnvIdParts p;
+  const size_t slash = id.find('/');
+  if (slash == std::string_view::npos) return p;
+  p.family = id.substr(0, slash);
+  const std::string_view rest = id.substr(slash + 1);
+  const size_t colon = rest.find(':');
+  p.name = rest.substr(0, colon);
+  if (colon != std::string_view::npos) p.variant = rest.substr(colon + 1);
+  return p;
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -165,22 +178,6 @@ const EnvSpec* find_listed(std::string_view id) {
                   "; `cradle envs` lists them all)");
 }
 
-// Splits "family/name[:variant]".
-struct ParsedId {
-  std::string family, name, variant;
-};
-ParsedId parse(std::string_view id) {
-  ParsedId p;
-  const size_t slash = id.find('/');
-  if (slash == std::string_view::npos) return p;
-  p.family = id.substr(0, slash);
-  std::string_view rest = id.substr(slash + 1);
-  const size_t colon = rest.find(':');
-  p.name = rest.substr(0, colon);
-  if (colon != std::string_view::npos) p.variant = rest.substr(colon + 1);
-  return p;
-}
-
 // Options a family does not take are refused by name.
 void refuse_options(const EnvOptions& options, std::string_view family) {
   if (!options.empty()) {
@@ -222,7 +219,7 @@ EnvMaker mimo_maker(const std::string& registered, const EnvOptions& options) {
   };
 }
 
-EnvMaker tma_maker(const ParsedId& p, const EnvOptions& options) {
+EnvMaker tma_maker(const EnvIdParts& p, const EnvOptions& options) {
   tma::TmaOptions o{.env = tma::parse_env_id(p.name), .body = p.variant};
   if (p.variant.empty()) {
     throw UserError("env id 'tma/" + p.name + "' names no embodiment (expected tma/" + p.name +
@@ -240,7 +237,7 @@ EnvMaker tma_maker(const ParsedId& p, const EnvOptions& options) {
   };
 }
 
-EnvMaker sami_maker(const ParsedId& p, const EnvOptions& options) {
+EnvMaker sami_maker(const EnvIdParts& p, const EnvOptions& options) {
   const sami::EnvId id = sami::env_from_name(p.name);
   const std::string split = p.variant.empty() ? "train" : p.variant;
   sami::Options so;
@@ -299,7 +296,7 @@ EnvSpec env_spec(std::string_view id) {
             .parameters = babybench_task_parameters(config),
             .config = std::string(id)};
   }
-  const ParsedId p = parse(id);
+  const EnvIdParts p = split_env_id(id);
   if (p.family == "sami" && !p.name.empty() && is_yaml(p.variant)) {
     const sami::EnvId sid = sami::env_from_name(p.name);
     return {.id = std::string(id),
@@ -329,7 +326,7 @@ EnvMaker env_maker(std::string_view id, const EnvOptions& options) {
                            options);
   }
   if (spec.family == "mimo") return mimo_maker(spec.aliases.at(0), options);
-  const ParsedId p = parse(spec.id);
+  const EnvIdParts p = split_env_id(spec.id);
   if (spec.family == "tma") return tma_maker(p, options);
   return sami_maker(p, options);
 }

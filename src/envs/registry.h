@@ -50,6 +50,13 @@ using EnvOptions = std::map<std::string, std::string, std::less<>>;
 // split). The env is reset with `seed`.
 using EnvMaker = std::function<std::unique_ptr<Env>(int index, std::uint64_t seed)>;
 
+// The parts of an id "family/name[:variant]" ("tma/parkour:fish": tma, parkour, fish); a part the
+// id lacks is empty.
+struct EnvIdParts {
+  std::string family, name, variant;
+};
+EnvIdParts split_env_id(std::string_view id);
+
 // Every listed id, by family (babybench, mimo, tma, sami) then name.
 const std::vector<EnvSpec>& env_specs();
 // The spec of an id, an alias or an unlisted form (a YAML path). Throws UserError for an unknown

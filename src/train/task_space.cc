@@ -124,9 +124,9 @@ CurriculumSpec env_curriculum(const envs::EnvSpec& env) {
   CurriculumSpec spec;
   // TeachMyAgent's benchmark facts are its student runs' (train/tma_run.h).
   if (env.family == "tma") {
-    const std::string name = env.id.substr(4, env.id.find(':') - 4);
-    const StudentEnv student = tma_student_env(
-        {.env = tma::parse_env_id(name), .body = env.id.substr(env.id.find(':') + 1)});
+    const envs::EnvIdParts id = envs::split_env_id(env.id);
+    const StudentEnv student =
+        tma_student_env({.env = tma::parse_env_id(id.name), .body = id.variant});
     spec.space = student.space;
     spec.reward_lb = student.reward_lb;
     spec.reward_ub = student.reward_ub;

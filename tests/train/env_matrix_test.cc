@@ -178,6 +178,20 @@ TEST(EnvMatrix, SamiResetOptionsSetTheHiddenParameters) {
   EXPECT_DOUBLE_EQ(dynamic_cast<envs::SamiEnvAdapter&>(*panda).sami().info().mass, 7.0);
 }
 
+// An id's parts, as every family's maker and the run read them.
+TEST(EnvMatrix, AnIdSplitsIntoFamilyNameAndVariant) {
+  const envs::EnvIdParts fish = envs::split_env_id("tma/parkour:fish");
+  EXPECT_EQ(fish.family, "tma");
+  EXPECT_EQ(fish.name, "parkour");
+  EXPECT_EQ(fish.variant, "fish");
+  const envs::EnvIdParts reach = envs::split_env_id("mimo/reach");
+  EXPECT_EQ(reach.family, "mimo");
+  EXPECT_EQ(reach.name, "reach");
+  EXPECT_EQ(reach.variant, "");
+  const envs::EnvIdParts none = envs::split_env_id("reach");
+  EXPECT_EQ(none.family + none.name + none.variant, "");
+}
+
 TEST(EnvMatrix, AnUnknownIdNamesTheClosestOnes) {
   try {
     envs::env_spec("sami/CripleAnt");

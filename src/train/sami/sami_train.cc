@@ -123,8 +123,7 @@ SamiRunFile read_sami_run(const fs::path& run) {
                     "' is not one of SaMI's learners (expected tesac, ccm, satesac, saccm or "
                     "saccm_all)");
   }
-  r.env = r.env_id.substr(
-      5, r.env_id.find(':') == std::string::npos ? std::string::npos : r.env_id.find(':') - 5);
+  r.env = envs::split_env_id(r.env_id).name;
   try {
     sami::env_from_name(r.env);
   } catch (const UserError& e) {
