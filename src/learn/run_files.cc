@@ -6,7 +6,6 @@
 #include <iostream>
 #include <iterator>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <system_error>
 
 #include "core/error.h"
@@ -183,24 +182,16 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
 
 void cut_to_checkpoint(const fs::path& file, std::uintmax_t size) {
   std::error_code ec;
-  const std::uintmax_t now = fs::exists(file, ec) ? fs::file_size(file, ec) : 0;
-  if (now < size) {
+  const std::string text = fs::exists(file, ec) ? read_all(file) : std::string();
+  if (text.size() < size) {
     throw UserError("--resume: '" + file.string() + "' is shorter than at the checkpoint (" +
-                    std::to_string(now) + " < " + std::to_string(size) + " bytes)");
+                    std::to_string(text.size()) + " < " + std::to_string(size) + " bytes)");
   }
-  if (now == size) return;
-  std::ifstream in(file, std::ios::binary);
-  in.seekg(static_cast<std::streamoff>(size));
-  std::ostringstream tail;
-  tail << in.rdbuf();
-  in.close();
+  if (text.size() == size) return;
   const fs::path aside =
       file.parent_path() / (file.stem().string() + ".after-checkpoint" + file.extension().string());
-  std::ofstream out(aside, std::ios::app | std::ios::binary);
-  out << tail.str();
-  if (!out.flush()) throw UserError("cannot write '" + aside.string() + "'");
-  fs::resize_file(file, size, ec);
-  if (ec) throw UserError("cannot cut '" + file.string() + "': " + ec.message());
+  append_to(aside, std::string_view(text).substr(size));
+  write_atomically(file, std::string_view(text).substr(0, size));
   std::cerr << file.filename().string() << ": lines after the checkpoint kept in " << aside.string()
             << "\n";
 }
