@@ -187,7 +187,7 @@ struct Run {
   Config env_config;
   fs::path log_file;
   long kept_episodes = -1;
-  // make_curriculum
+  // make_curriculum (check_options builds a named teacher's controller)
   std::shared_ptr<teach::TeacherController> curriculum;
   EnvWrapper wrap;
   std::optional<JsonlWriter> teacher_log;
@@ -305,10 +305,10 @@ void check_options(Run& run) {
                                   .parameters = envs::babybench_task_parameters(run.config)});
   }
   if (!options.teacher.empty()) run.curriculum_spec->teacher = options.teacher;
-  // The named teacher is built once here, so that an unknown name or a bad parameter is refused
-  // before --overwrite removes anything.
+  // A named teacher's controller is built here, so that an unknown name or a bad parameter is
+  // refused before --overwrite removes anything (a teacher object's, in make_curriculum).
   if (run.curriculum_spec && !options.teacher_factory)
-    (void)make_controller(*run.curriculum_spec, options.seed);
+    run.curriculum = make_controller(*run.curriculum_spec, options.seed + run.rank);
   if (options.procs != 0 && run.curriculum_spec)
     throw UserError("--procs is not available with a curriculum (--task-space or --teacher)");
   if (run.sync) {
@@ -373,10 +373,9 @@ void make_curriculum(Run& run) {
   const fs::path teacher_file = run.dir / teacher_book(run.rank);
   const std::uint64_t teacher_seed = options.seed + run.rank;
   const CurriculumSpec& spec = *run.curriculum_spec;
-  run.curriculum =
-      options.teacher_factory
-          ? make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed)
-          : make_controller(spec, teacher_seed);
+  if (options.teacher_factory)
+    run.curriculum =
+        make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed);
   if (options.resume && fs::exists(teacher_file)) {
     const auto size = run.resumed.log_sizes.find(teacher_book(run.rank));
     if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(teacher_file, size->second);
