@@ -344,8 +344,8 @@ def main():
     subprocess.run([cradle] + tiny_tma + ["--steps", "1000", "--out", tma_run], check=True,
                    capture_output=True)
     damaged_runs(s, "run files: tma run", tma_run,
-                 [("run.json", ["arguments"]), "checkpoints/latest.json", "teacher.jsonl",
-                  "checkpoints/step_1000.ckpt"],
+                 [("run.json", ["arguments"]), "checkpoints/latest.ckpt", "logs/teacher.jsonl",
+                  "progress.csv"],
                  lambda run: tiny_tma + ["--steps", "2000", "--out", run, "--resume"], args.quick)
     damaged_runs(s, "run files: tma video", tma_run, [("run.json", ["arguments"]), "test_set.csv"],
                  lambda run: ["tma", "video", "--run", run, "--test-task", "0", "--steps", "5",

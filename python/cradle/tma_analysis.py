@@ -253,6 +253,8 @@ def load_results(root):
             run = load_run(dirpath)
             if run is not None:
                 runs.append(run)
+            # A run's own folders (logs/ holds every run's per-report progress.csv) are no runs.
+            dirnames[:] = []
     runs.sort(key=lambda r: (r.label, r.experiment, r.ek, r.embodiment, r.student, r.seed))
     return runs
 
@@ -461,10 +463,13 @@ def plot_skill_bars(table, file):
 
 
 def _teacher_records(path):
-    """teacher.jsonl -> (training tasks with env steps, dumps with env steps); empty without the
-    file. A line that is not a JSON record of `cradle tma run` raises AnalysisInputError."""
+    """logs/teacher.jsonl (teacher.jsonl in runs of earlier versions) -> (training tasks with env
+    steps, dumps with env steps); empty without the file. A line that is not a JSON record of
+    `cradle tma run` raises AnalysisInputError."""
     tasks, steps, dumps = [], [], []
-    file = os.path.join(path, "teacher.jsonl")
+    file = os.path.join(path, "logs", "teacher.jsonl")
+    if not os.path.exists(file) and os.path.exists(os.path.join(path, "teacher.jsonl")):
+        file = os.path.join(path, "teacher.jsonl")
     text = _read_text(file, "the teacher.jsonl of `cradle tma run`") or ""
     for number, line in enumerate(text.split("\n"), 1):
         if not line.strip():
@@ -760,7 +765,8 @@ def write_synthetic_run(d, teacher, seed, strength=0.5, evaluations=21, test_tas
     pd.DataFrame([(k, h, sp) for k, (h, sp) in enumerate(grid)], columns=[
         "task_index", "stump_height", "obstacle_spacing",
     ]).to_csv(os.path.join(d, "test_set.csv"), index=False)
-    with open(os.path.join(d, "teacher.jsonl"), "w") as f:
+    os.makedirs(os.path.join(d, "logs"), exist_ok=True)
+    with open(os.path.join(d, "logs", "teacher.jsonl"), "w") as f:
         for rec in teacher_rows:
             f.write(json.dumps(rec) + "\n")
 

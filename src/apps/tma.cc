@@ -1,6 +1,6 @@
 // `cradle tma random|bench|info|run`: TeachMyAgent's environments from the command line.
 //   run    --env ... --embodiment E --student sac|ppo --teacher T [...]: a student trained with a
-//          teacher, the reference's run.py (train/tma_run.h; run folder in docs/tma_run.md);
+//          teacher, the reference's run.py (train/tma_student.h; run folder in docs/tma_run.md);
 //   random --env stump-tracks|parkour --embodiment E [--task k=v ...] [--video out.mp4]
 //          [--steps N] [--seed S] [--png F]: one random-policy episode (return, length, success);
 //   run and random also take run.py's body and Parkour options (--motors_torque, --nb_of_bodies,
@@ -36,7 +36,7 @@
 #include "tma/cppn.h"
 #include "tma/render.h"
 #include "tma/tma_env.h"
-#include "train/tma_run.h"
+#include "train/tma_student.h"
 
 namespace cradle::apps {
 namespace {

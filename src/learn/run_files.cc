@@ -22,6 +22,10 @@ constexpr const char* kRunSection = "run";
 constexpr std::string_view kIntrinsicPrefix = "intrinsic/";
 
 std::string read_all(const fs::path& file) {
+  // A folder opens as a stream whose first read throws: refuse it by name first.
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec))
+    throw UserError("cannot read " + file.string() + ": not a file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw UserError("cannot read " + file.string());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -110,6 +114,9 @@ void save_run_checkpoint(const fs::path& file, const Learner& learner,
   // Only runs that keep such logs record them: the other checkpoints stay as they were.
   if (!run.log_sizes.empty()) state["log_sizes"] = run.log_sizes;
   if (!run.teacher_steps.empty()) state["teacher_steps"] = run.teacher_steps;
+  if (run.step_offset != 0) state["step_offset"] = run.step_offset;
+  if (run.learner_resets != 0) state["learner_resets"] = run.learner_resets;
+  if (!run.experiment.empty()) state["experiment"] = run.experiment;
   sections[kRunSection] = state.dump();
   if (reward) {
     const Staging staging(file);
@@ -141,6 +148,18 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
     if (!j["intrinsic"].is_string())
       throw UserError(file.string() + ": checkpoint run state is malformed");
     state.intrinsic = j["intrinsic"].get<std::string>();
+  }
+  for (const char* key : {"step_offset", "learner_resets"}) {
+    if (!j.contains(key)) continue;
+    if (!j[key].is_number_unsigned())
+      throw UserError(file.string() + ": checkpoint run state is malformed (" + key + ")");
+    (key == std::string("step_offset") ? state.step_offset : state.learner_resets) =
+        j[key].get<long>();
+  }
+  if (j.contains("experiment")) {
+    if (!j["experiment"].is_string())
+      throw UserError(file.string() + ": checkpoint run state is malformed (experiment)");
+    state.experiment = j["experiment"].get<std::string>();
   }
   // Counts by paths inside the run folder (sizes in bytes, teacher steps).
   for (const char* key : {"log_sizes", "teacher_steps"}) {
@@ -182,6 +201,8 @@ RunState load_run_state(const fs::path& file, intrinsic::IntrinsicReward* reward
 
 void cut_to_checkpoint(const fs::path& file, std::uintmax_t size) {
   std::error_code ec;
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec))
+    throw UserError("--resume: '" + file.string() + "' is not a file (expected the run's log)");
   const std::string text = fs::exists(file, ec) ? read_all(file) : std::string();
   if (text.size() < size) {
     throw UserError("--resume: '" + file.string() + "' is shorter than at the checkpoint (" +

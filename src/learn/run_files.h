@@ -34,6 +34,13 @@ struct RunState {
   // The step counts of each rank's teacher controller (by its book's path): the env steps its
   // envs took, which autoreset steps do not count, so not `steps`.
   std::map<std::string, long> teacher_steps;
+  // A run that replaces its learner now and then (TrainOptions::reset_every): the run's env steps
+  // before the current learner's first, and how many fresh learners it has made. 0 elsewhere.
+  long step_offset = 0;
+  long learner_resets = 0;
+  // What an experiment of the run keeps across a resume (train/experiment.h), as JSON text; empty
+  // for runs without one.
+  std::string experiment;
 };
 
 // Writes `file`: the learner's checkpoint with sections "run" (RunState as JSON) and

@@ -1,6 +1,6 @@
-// cradle.tma.run: `cradle tma run` (train/tma_run.h) from Python, with the same checks and run
+// cradle.tma.run: `cradle tma run` (train/tma_student.h) from Python, with the same checks and run
 // folder. The GIL is released while C++ trains.
-#include "train/tma_run.h"
+#include "train/tma_student.h"
 
 #include <string>
 

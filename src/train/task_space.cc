@@ -12,7 +12,7 @@
 #include "teach/registry.h"
 #include "tma/tma_env.h"
 #include "train/run_json.h"
-#include "train/tma_run.h"
+#include "train/tma_student.h"
 
 namespace cradle::train {
 namespace {
@@ -122,7 +122,7 @@ CurriculumSpec env_curriculum(const envs::EnvSpec& env) {
                     "env's); give --task-space FILE.yml");
   }
   CurriculumSpec spec;
-  // TeachMyAgent's benchmark facts are its student runs' (train/tma_run.h).
+  // TeachMyAgent's benchmark facts are its student runs' (train/tma_student.h).
   if (env.family == "tma") {
     const envs::EnvIdParts id = envs::split_env_id(env.id);
     const StudentEnv student =
@@ -154,6 +154,11 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
       .scale_reward = spec.scale_reward,
       .params = spec.teacher_params};
   setup.initial_dist = spec.initial_dist;
+  // The teacher works in the shuffled space: the easy region's mean maps there.
+  if (spec.shuffle_dimensions && setup.initial_dist) {
+    const teach::DimensionShuffle shuffle(setup.mins, setup.maxs, seed);
+    setup.initial_dist->mean = shuffle.to_shuffled(setup.initial_dist->mean);
+  }
   return make_controller(spec, teach::make_teacher(setup), seed);
 }
 
@@ -164,10 +169,14 @@ std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& 
   return std::make_shared<teach::TeacherController>(
       std::move(teacher), *spec.space,
       teach::ControllerOptions{.seed = seed,
+                               .shuffle_dimensions = spec.shuffle_dimensions,
                                .scale_reward = spec.scale_reward,
                                .reward_lb = spec.reward_lb,
                                .reward_ub = spec.reward_ub,
-                               .test_set = teach::default_test_set(*spec.space, 1)});
+                               .test_set = spec.test_set.empty()
+                                               ? teach::default_test_set(*spec.space, 1)
+                                               : spec.test_set,
+                               .keep_periodical_task_samples = spec.keep_periodical_task_samples});
 }
 
 namespace {

@@ -40,6 +40,12 @@ struct CurriculumSpec {
   // The task space's easy region, which teachers start from with high expert knowledge (Stump
   // Tracks' no-stumps corner); task-space files have none.
   std::optional<teach::DiagGaussian> initial_dist;
+  // A family's own curriculum (not in task-space files): the teacher works in a shuffled space
+  // (TeachMyAgent's rugged difficulty), the controller keeps snapshots of 100 sampled tasks every
+  // this many env steps (0: none), and evaluations walk this test set (empty: the default one).
+  bool shuffle_dimensions = false;
+  long keep_periodical_task_samples = 0;
+  std::vector<teach::Task> test_set;
 };
 
 // Parses the YAML text (`source` names it in errors). UserError, one line, for an unknown key,
@@ -64,8 +70,8 @@ using TeacherFactory = std::function<std::unique_ptr<teach::Teacher>(const teach
                                                                      std::uint64_t seed)>;
 
 // The controller of a spec: its teacher seeded with `seed` (UserError for an unknown teacher or
-// a bad parameter); the test set is the default one (curricula here have no evaluation of their
-// own).
+// a bad parameter), in the shuffled space when the spec shuffles (the easy region's mean mapped
+// there).
 std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,
                                                           std::uint64_t seed);
 // The same controller around a ready teacher (spec.teacher, teacher_params and expert_knowledge

@@ -1,5 +1,6 @@
 #include "train/trainer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +8,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -191,6 +193,9 @@ struct Run {
   std::shared_ptr<teach::TeacherController> curriculum;
   EnvWrapper wrap;
   std::optional<JsonlWriter> teacher_log;
+  // The curriculum's envs (their time in the teacher), registered as the vector makes them.
+  std::mutex curriculum_envs_mutex;
+  std::vector<const CurriculumEnv*> curriculum_envs;
   // make_vector
   TrainingVector training;
   std::unique_ptr<intrinsic::Composite> reward;
@@ -198,11 +203,23 @@ struct Run {
   double score_sum = 0;
   int score_count = 0;
   std::unique_ptr<Learner> learner;
+  // A run that resets its learner: the run's steps before the current learner's, and how many
+  // fresh learners it has made.
+  long offset = 0;
+  long resets = 0;
   // open_logs: progress.csv's columns (the learner's own report keys last) and rows so far.
   std::vector<std::string> extra;
   fs::path csv_file;
   std::ofstream csv;
   std::vector<std::vector<double>> rows;
+  // train_loop: when this process began training, and the run's steps then; the step of the last
+  // evaluation (-1: none).
+  Clock::time_point start = Clock::now();
+  long first_steps = 0;
+  long last_evaluated = -1;
+
+  // The run's env steps (over every learner of a run that resets).
+  long steps() const { return offset + learner->steps(); }
 };
 
 // Every option checked and the run's settings resolved; nothing is written before this.
@@ -211,6 +228,9 @@ void check_options(Run& run) {
   if (options.steps < 1) throw UserError("--steps must be at least 1");
   if (options.envs < 1) throw UserError("--envs must be at least 1");
   if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
+  if (options.reset_every < 0) throw UserError("--reset-every must be >= 0 (0: never)");
+  if (options.experiment && options.experiment->evaluate_every() < 1)
+    throw UserError("the run's evaluations need at least 1 env step between them");
   // Worker processes: each holds the same number of envs; their envs' teacher and batches would
   // live apart from this process's.
   if (options.procs != 0) {
@@ -258,6 +278,14 @@ void check_options(Run& run) {
     run.hyperparameters = parse_hyperparameter_text(info.config);
     for (const auto& [name, value] : options.hyperparameters) run.hyperparameters[name] = value;
     run.resumed = load_run_state(run.latest, nullptr);
+    // An experiment continues from its own state at the checkpoint.
+    if (options.experiment && run.resumed.experiment.empty()) {
+      throw UserError("--resume: '" + run.latest.string() +
+                      "' holds no state of this run's evaluations (written by another kind of "
+                      "run); give --overwrite to start it anew");
+    }
+    run.offset = run.resumed.step_offset;
+    run.resets = run.resumed.learner_resets;
     // The rewards are part of the task being learned: a resumed run keeps them.
     const std::string wanted =
         options.intrinsic.empty() ? "" : intrinsic::parse_intrinsic(options.intrinsic)->describe();
@@ -294,8 +322,12 @@ void check_options(Run& run) {
   const bool own_teacher = !options.teacher.empty() || options.teacher_factory;
   if (!options.teacher.empty() && options.teacher_factory)
     throw UserError("a teacher name and a teacher object: give one of them");
+  if (!options.task_space.empty() && options.curriculum)
+    throw UserError("--task-space and the run's own curriculum: give one of them");
   if (!options.task_space.empty()) {
     run.curriculum_spec = load_task_space(options.task_space, /*need_teacher=*/!own_teacher);
+  } else if (options.curriculum) {
+    run.curriculum_spec = options.curriculum;
   } else if (own_teacher) {
     // Without a file, the teacher sets every task parameter the env declares.
     run.curriculum_spec = env_curriculum(
@@ -319,6 +351,9 @@ void check_options(Run& run) {
         {{"--envs", options.envs},
          {"--steps", static_cast<double>(options.steps)},
          {"--checkpoint-every", static_cast<double>(options.checkpoint_every)},
+         {"--reset-every", static_cast<double>(options.reset_every)},
+         {"the evaluations' interval",
+          options.experiment ? static_cast<double>(options.experiment->evaluate_every()) : 0.0},
          {"--algo", static_cast<double>(std::hash<std::string>{}(run.algorithm) % (1L << 40))},
          {"--hp", static_cast<double>(std::hash<std::string>{}(hp_text) % (1L << 40))},
          {"--resume", options.resume ? 1.0 : 0.0},
@@ -335,21 +370,38 @@ void open_run_folder(Run& run) {
   const TrainOptions& options = run.options;
   if (!options.resume) {
     std::error_code ec;
-    const fs::path progress = run.dir / "logs" / "progress.csv";
-    const bool holds_run = fs::exists(run.latest, ec) || has_rows(progress);
-    if (holds_run && !options.overwrite) {
-      throw UserError("'" + run.dir.string() + "' holds a run (" +
-                      (fs::exists(run.latest, ec) ? run.latest : progress).string() +
+    // What a run leaves: its checkpoint, progress rows, an experiment's files.
+    fs::path held;
+    if (fs::exists(run.latest, ec)) held = run.latest;
+    if (held.empty() && has_rows(run.dir / "logs" / "progress.csv"))
+      held = run.dir / "logs" / "progress.csv";
+    std::vector<std::string> removed = {"checkpoints", "logs", "plots", "ranks"};
+    if (options.experiment) {
+      for (const std::string& file : options.experiment->files()) {
+        if (held.empty() && fs::exists(run.dir / file, ec)) held = run.dir / file;
+        removed.push_back(file);
+      }
+    }
+    if (!held.empty() && !options.overwrite) {
+      throw UserError("'" + run.dir.string() + "' holds a run (" + held.string() +
                       "): give --resume to continue it, --overwrite to replace it, or another "
                       "--save-dir");
     }
-    if (holds_run && run.rank == 0) {
-      for (const char* sub : {"checkpoints", "logs", "plots", "ranks"}) {
+    if (!held.empty() && run.rank == 0) {
+      for (const std::string& sub : removed) {
         fs::remove_all(run.dir / sub, ec);
         if (ec) throw UserError("--overwrite: cannot remove '" + (run.dir / sub).string() + "'");
       }
     }
   }
+  // An experiment's logs cut back to what the checkpoint knows (later lines kept aside).
+  if (options.resume && options.experiment && run.rank == 0) {
+    for (const std::string& log : options.experiment->logs()) {
+      const auto size = run.resumed.log_sizes.find(log);
+      if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(run.dir / log, size->second);
+    }
+  }
+  if (run.rank == 0) make_folder(run.dir, "cannot create the run folder");
   if (run.rank > 0)
     run.env_config.save_dir = (run.dir / "ranks" / std::to_string(run.rank)).string();
   run.log_file = fs::path(run.env_config.save_dir) / "logs" / "training.jsonl";
@@ -377,24 +429,36 @@ void make_curriculum(Run& run) {
     run.curriculum =
         make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed);
   if (options.resume && fs::exists(teacher_file)) {
+    // Every line checked before the book is cut or replayed: a damaged book changes nothing.
+    check_teacher_book(teacher_file, spec.space->dims());
     const auto size = run.resumed.log_sizes.find(teacher_book(run.rank));
     if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(teacher_file, size->second);
-    replay_teacher_book(*run.curriculum, teacher_file, /*periodical=*/false);
+    replay_teacher_book(*run.curriculum, teacher_file, /*periodical=*/true);
     // The controller's step count at the checkpoint (its last booked episode may be earlier).
     const auto steps = run.resumed.teacher_steps.find(teacher_book(run.rank));
     if (steps != run.resumed.teacher_steps.end()) run.curriculum->continue_from(steps->second);
   }
-  run.wrap = [curriculum = run.curriculum, o = spec.env_options](std::unique_ptr<envs::Env> env) {
-    return std::make_unique<CurriculumEnv>(std::move(env), curriculum, o);
+  run.wrap = [&run, o = spec.env_options](std::unique_ptr<envs::Env> env) {
+    auto wrapped = std::make_unique<CurriculumEnv>(std::move(env), run.curriculum, o);
+    const std::lock_guard lock(run.curriculum_envs_mutex);
+    run.curriculum_envs.push_back(wrapped.get());
+    return wrapped;
   };
   run.teacher_log.emplace(teacher_file, options.resume);
 }
 
-// The teacher's new episodes (and with `dump` its state) to logs/teacher.jsonl.
+// The teacher's new episodes and task snapshots (and with `dump` its state) to
+// logs/teacher.jsonl; an experiment hears each episode.
 void write_teacher_log(Run& run, bool dump) {
   if (!run.teacher_log) return;
-  for (const teach::EpisodeRecord& e : run.curriculum->take_episodes())
+  Experiment* experiment = run.rank == 0 ? run.options.experiment.get() : nullptr;
+  for (const teach::EpisodeRecord& e : run.curriculum->take_episodes()) {
     run.teacher_log->write(teach::train_line(e));
+    if (experiment) experiment->booked(e);
+  }
+  for (const teach::PeriodicalRecord& p : run.curriculum->take_periodical())
+    run.teacher_log->write(
+        {{"kind", "periodical"}, {"env_steps", p.env_steps}, {"tasks", p.tasks}});
   if (dump)
     run.teacher_log->write(
         teach::dump_line(run.curriculum->env_steps(), run.curriculum->teacher_dump()));
@@ -410,9 +474,9 @@ void make_vector(Run& run) {
       make_folder(logs, "cannot create");
     }
   }
-  run.training = run.by_id ? make_env_training(run.env_id, options.envs, options.threads,
-                                               options.seed + run.rank, run.wrap,
-                                               options.async_batch, {}, options.procs)
+  run.training = run.by_id ? make_env_training(
+                                 run.env_id, options.envs, options.threads, options.seed + run.rank,
+                                 run.wrap, options.async_batch, options.env_options, options.procs)
                            : make_babybench_training(run.env_config, options.envs, options.threads,
                                                      options.seed + run.rank, run.kept_episodes,
                                                      run.wrap, options.async_batch, options.procs);
@@ -428,12 +492,13 @@ void make_vector(Run& run) {
   }
 }
 
-// The learner, fresh or resumed from latest.ckpt. Its reward hook adds the intrinsic rewards
-// and the caller's terms, and tallies the behaviour score of each episode that ends (async: the
-// batch, whose slot i is env env_id(i)).
-void make_learner(Run& run) {
+// A fresh learner (the run's k-th after k resets, seeded apart). Its reward hook adds the
+// intrinsic rewards and the caller's terms, and tallies the behaviour score of each episode that
+// ends (async: the batch, whose slot i is env env_id(i)).
+std::unique_ptr<Learner> fresh_learner(Run& run) {
   const TrainOptions& options = run.options;
-  LearnerOptions lo{.seed = options.seed + run.rank, .hyperparameters = run.hyperparameters};
+  LearnerOptions lo{.seed = options.seed + run.rank + 7919 * static_cast<std::uint64_t>(run.resets),
+                    .hyperparameters = run.hyperparameters};
   lo.sync = options.sync;
   lo.update_threads = options.update_threads;
   lo.reward_hook = [&run](const VecEnv& env, std::span<const double> actions,
@@ -450,7 +515,13 @@ void make_learner(Run& run) {
       }
     }
   };
-  run.learner = learn::make_learner(run.algorithm, *run.training.vec, lo);
+  return learn::make_learner(run.algorithm, *run.training.vec, lo);
+}
+
+// The learner, fresh or resumed from latest.ckpt.
+void make_learner(Run& run) {
+  const TrainOptions& options = run.options;
+  run.learner = fresh_learner(run);
   // SPDL values its tasks with the student's value function.
   if (run.curriculum)
     run.curriculum->teacher().set_value_estimator(learner_value_estimator(
@@ -483,7 +554,9 @@ void open_logs(Run& run) {
         {"task_space", options.task_space},
         {"teacher", options.teacher},
         {"world_size", run.sync ? run.sync->world_size() : 1}};
+    if (options.reset_every > 0) json["reset_every"] = options.reset_every;
     if (!run.by_id) json["config"] = to_json(run.config);
+    for (const auto& [key, value] : options.run_json.items()) json[key] = value;
     write_atomically(run.dir / "run.json", json.dump(2) + "\n");
   }
   run.csv_file = run.dir / "logs" / "progress.csv";
@@ -494,7 +567,8 @@ void open_logs(Run& run) {
   std::string header;
   for (size_t c = 0; c < columns.size(); ++c) header += (c ? "," : "") + columns[c];
   ProgressCut cut;
-  if (options.resume && run.rank == 0) cut = cut_progress(run.csv_file, header, run.resumed.steps);
+  if (options.resume && run.rank == 0)
+    cut = cut_progress(run.csv_file, header, run.resumed.step_offset + run.resumed.steps);
   if (!cut.kept_aside.empty())
     std::cerr << "progress.csv rows kept aside in " << cut.kept_aside.string() << "\n";
   // The other ranks' stream writes nowhere.
@@ -503,6 +577,17 @@ void open_logs(Run& run) {
   if (!cut.append) run.csv << header << "\n";
   run.rows = std::move(cut.rows);
   for (auto& row : run.rows) row.resize(columns.size(), std::nan(""));
+  // An experiment's own files, fresh or continued from its state at the checkpoint.
+  if (options.experiment && run.rank == 0) {
+    nlohmann::json state;
+    if (options.resume) {
+      state = nlohmann::json::parse(run.resumed.experiment, nullptr, /*allow_exceptions=*/false);
+      if (state.is_discarded())
+        throw UserError("--resume: '" + run.latest.string() +
+                        "': the run state's experiment section is not JSON");
+    }
+    options.experiment->open(run.dir, options.resume ? &state : nullptr);
+  }
 }
 
 // A checkpoint is an episode boundary: every env's episode is recorded (cut short) and the log
@@ -513,7 +598,9 @@ void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
   if (run.training.log) run.training.log->flush();
   RunState state{.steps = run.learner->steps(),
                  .episodes = run.training.log ? run.training.log->episodes() : 0,
-                 .intrinsic = run.reward ? run.reward->describe() : ""};
+                 .intrinsic = run.reward ? run.reward->describe() : "",
+                 .step_offset = run.offset,
+                 .learner_resets = run.resets};
   // The teacher books of every rank as long as the episodes the checkpoint knows.
   if (run.teacher_log) {
     write_teacher_log(run, false);
@@ -529,24 +616,111 @@ void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
     }
   }
   if (run.rank > 0) return;
-  for (const fs::path& file : files)
-    save_run_checkpoint(file, *run.learner, run.reward.get(), state);
+  // An experiment's state and the sizes of its logs.
+  if (const Experiment* experiment = run.options.experiment.get()) {
+    state.experiment = experiment->state().dump();
+    for (const std::string& log : experiment->logs()) {
+      std::error_code ec;
+      const std::uintmax_t size = fs::file_size(run.dir / log, ec);
+      if (!ec) state.log_sizes[log] = size;
+    }
+  }
+  // One write; the other names are the same file (hard links, or copies where links fail).
+  save_run_checkpoint(files.front(), *run.learner, run.reward.get(), state);
+  for (size_t k = 1; k < files.size(); ++k) {
+    const fs::path tmp = files[k].string() + ".tmp";
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    fs::create_hard_link(files.front(), tmp, ec);
+    if (ec) fs::copy_file(files.front(), tmp, fs::copy_options::overwrite_existing, ec);
+    if (!ec) fs::rename(tmp, files[k], ec);
+    if (ec) throw UserError("cannot write '" + files[k].string() + "': " + ec.message());
+  }
+  // The newest step checkpoint alone, when the run keeps only that.
+  const std::string newest = "step_" + std::to_string(run.steps()) + ".ckpt";
+  const bool wrote_step = std::any_of(files.begin(), files.end(),
+                                      [&](const fs::path& f) { return f.filename() == newest; });
+  if (!run.options.keep_step_checkpoints && wrote_step) {
+    std::error_code ec;
+    std::vector<fs::path> older;
+    for (const auto& entry : fs::directory_iterator(run.checkpoints, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.starts_with("step_") && name.ends_with(".ckpt") && name != newest)
+        older.push_back(entry.path());
+    }
+    for (const fs::path& file : older) fs::remove(file, ec);
+  }
+}
+
+// What an experiment's hooks see of the run now.
+RunView view(const Run& run) {
+  double teacher_seconds = 0;
+  for (const CurriculumEnv* env : run.curriculum_envs) teacher_seconds += env->teacher_seconds();
+  return {.learner = *run.learner,
+          .steps = run.steps(),
+          .first_steps = run.first_steps,
+          .seconds = std::chrono::duration<double>(Clock::now() - run.start).count(),
+          .teacher_seconds = teacher_seconds,
+          .curriculum = run.curriculum.get()};
+}
+
+// An experiment's evaluation (rank 0) after the teacher's book has every ended episode, then the
+// teacher's state in the book at the run's step.
+void evaluate(Run& run) {
+  write_teacher_log(run, false);
+  if (run.rank == 0) {
+    run.options.experiment->evaluate(view(run));
+    if (run.teacher_log) {
+      run.teacher_log->write(teach::dump_line(run.steps(), run.curriculum->teacher_dump()));
+      run.teacher_log->flush();
+    }
+  }
+  run.last_evaluated = run.steps();
+}
+
+// A fresh learner in place of the last; the run's step count goes on from it.
+void reset_learner(Run& run) {
+  run.offset = run.steps();
+  ++run.resets;
+  run.learner = fresh_learner(run);
+  if (run.rank == 0 && run.options.experiment) run.options.experiment->learner_replaced();
+}
+
+// The step checkpoint and latest.ckpt at the run's step.
+void save_step_checkpoint(Run& run) {
+  save_checkpoint(
+      run, {run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt"), run.latest});
 }
 
 // The loop: a progress row (and the teacher's book) at every report, a checkpoint every
 // checkpoint_every steps, learning stopped at each checkpoint and continued in a new learn()
-// call. Returns the next checkpoint's step.
+// call. With an experiment, its evaluations (before training, at each multiple of its interval,
+// at the end) place the checkpoints, and the run trains exactly to them and to each fresh
+// learner's step. Returns the next checkpoint's step.
 long train_loop(Run& run, TrainResult& result) {
   const TrainOptions& options = run.options;
-  const auto start = Clock::now();
-  const long first_step = run.learner->steps();
-  const ProgressBar bar(options.steps, first_step, options.progress_bar && run.rank == 0);
+  Experiment* experiment = options.experiment.get();
+  run.start = Clock::now();
+  run.first_steps = run.steps();
+  const long every = experiment ? experiment->evaluate_every() : options.checkpoint_every;
+  const bool exact = experiment || options.reset_every > 0;
+  auto next_multiple = [&](long k) { return (run.steps() / k + 1) * k; };
+  long next_checkpoint = next_multiple(every);
+  long next_reset = options.reset_every > 0 ? next_multiple(options.reset_every)
+                                            : std::numeric_limits<long>::max();
+  // A fresh experiment's evaluation of the untrained learner, a checkpoint to resume from.
+  if (experiment && !options.resume) {
+    evaluate(run);
+    save_step_checkpoint(run);
+  }
+  const ProgressBar bar(options.steps, run.first_steps, options.progress_bar && run.rank == 0);
   double last_score = std::nan("");
   // Stopping (Ctrl-C) is agreed by every rank of a data-parallel run.
   bool stopped = false;
   auto stopping = [&] { return run.sync ? stopped : options.stop && options.stop->load(); };
   auto on_progress = [&](const TrainStats& local) {
     TrainStats s = local;
+    s.steps += run.offset;
     if (run.sync) {
       stopped = pool_progress(*run.sync, s, run.score_sum, run.score_count,
                               options.stop && options.stop->load());
@@ -554,7 +728,8 @@ long train_loop(Run& run, TrainResult& result) {
     check_finite_losses(s, run.latest);
     write_teacher_log(run, false);
     if (run.reward) run.reward->update();
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (experiment && run.rank == 0) experiment->report(s);
+    const double elapsed = std::chrono::duration<double>(Clock::now() - run.start).count();
     if (run.score_count > 0) last_score = run.score_sum / run.score_count;
     const double window_score =
         run.score_count > 0 ? run.score_sum / run.score_count : std::nan("");
@@ -590,27 +765,40 @@ long train_loop(Run& run, TrainResult& result) {
 
     // Only BabyBench scores behaviour.
     bar.show(s.steps, elapsed,
-             "return " + csv_cell(s.episodic_return) +
-                 (run.by_id ? "" : "  score " + csv_cell(last_score)));
+             experiment ? experiment->status()
+                        : "return " + csv_cell(s.episodic_return) +
+                              (run.by_id ? "" : "  score " + csv_cell(last_score)));
     return true;
   };
-  const long next_checkpoint = run_loop(
-      *run.learner,
-      {.total_steps = options.steps,
-       .boundary_every = options.checkpoint_every,
-       .report = on_progress,
-       .at_boundary =
-           [&] {
-             save_checkpoint(
-                 run, {run.checkpoints / ("step_" + std::to_string(run.learner->steps()) + ".ckpt"),
-                       run.latest});
-           },
-       .stopping = stopping});
+  LoopOptions loop{.total_steps = options.steps,
+                   .offset = [&] { return run.offset; },
+                   .report = on_progress,
+                   .at_boundary =
+                       [&] {
+                         if (run.steps() >= next_reset) {
+                           reset_learner(run);
+                           next_reset = next_multiple(options.reset_every);
+                         }
+                         if (!exact || run.steps() >= next_checkpoint) {
+                           if (experiment) evaluate(run);
+                           save_step_checkpoint(run);
+                           next_checkpoint = next_multiple(every);
+                         }
+                       },
+                   .stopping = stopping};
+  if (exact)
+    loop.next_boundary = [&](long) { return std::min(next_checkpoint, next_reset); };
+  else
+    loop.boundary_every = every;
+  const long boundary = run_loop([&run]() -> Learner& { return *run.learner; }, loop);
+  // The experiment's last evaluation, at the end of the budget.
+  if (experiment && run.steps() >= options.steps && run.last_evaluated != run.steps())
+    evaluate(run);
   bar.finish();
-  result.steps = run.learner->steps();
-  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  result.steps_per_second = (result.steps - first_step) / std::max(result.seconds, 1e-9);
-  return next_checkpoint;
+  result.steps = run.steps();
+  result.seconds = std::chrono::duration<double>(Clock::now() - run.start).count();
+  result.steps_per_second = (result.steps - run.first_steps) / std::max(result.seconds, 1e-9);
+  return exact ? next_checkpoint : boundary;
 }
 
 // The end: the final checkpoint and the teacher's state, the ranks' networks compared, then (rank
@@ -619,11 +807,12 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   const TrainOptions& options = run.options;
   result.checkpoint = run.checkpoints / "final.ckpt";
   std::vector<fs::path> files = {run.latest, result.checkpoint};
-  if (run.learner->steps() >= next_checkpoint) {
-    files.push_back(run.checkpoints / ("step_" + std::to_string(run.learner->steps()) + ".ckpt"));
+  if (run.steps() >= next_checkpoint) {
+    files.push_back(run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt"));
   }
-  // The teacher's state closes its book before the checkpoint records the book's size.
-  write_teacher_log(run, true);
+  // The teacher's state closes its book before the checkpoint records the book's size (an
+  // experiment's evaluations dumped it already).
+  write_teacher_log(run, !options.experiment);
   save_checkpoint(run, files);
   VecEnv& vec = *run.training.vec;
   for (int i = 0; i < vec.num_envs(); ++i) vec.env(i).close();
@@ -638,13 +827,14 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
         "data-parallel contract)");
   }
   if (run.rank > 0) return;  // rank 0 draws, scores and evaluates the run
+  const bool stopped = options.stop && options.stop->load();
+  if (options.experiment) options.experiment->finish(view(run), stopped);
   if (!run.rows.empty()) plot_curves(run.rows, run.dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
   if (!run.by_id && fs::exists(run.log_file))
     result.training_score = eval::training_score(
         run.config.behavior,
         eval::read_training_log(run.log_file, run.config.behavior, run.training.geom_count));
-  const bool stopped = options.stop && options.stop->load();
   if (options.eval_episodes <= 0 || stopped) return;
   Learner* l = run.learner.get();
   // A run by id: the trained policy's whole episodes on a fresh env, acting deterministically

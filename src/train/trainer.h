@@ -7,7 +7,8 @@
 //   make_vector      the envs (threads, processes or async batches) and intrinsic rewards
 //   make_learner     fresh or resumed from checkpoints/latest.ckpt
 //   open_logs        run.json, logs/progress.csv (CleanRL names; cut back on resume)
-//   train_loop       a progress row per report, checkpoints/step_<n>.ckpt and latest.ckpt
+//   train_loop       a progress row per report, checkpoints/step_<n>.ckpt and latest.ckpt, an
+//                    experiment's evaluations and fresh learners at their exact steps
 //   finish           final.ckpt, the ranks' agreement, plots, the trained policy's evaluation
 // BabyBench configs also write the env training log and evaluate as BabyBench does.
 #pragma once
@@ -21,9 +22,11 @@
 #include <string>
 
 #include "core/config.h"
+#include "envs/registry.h"
 #include "learn/learner.h"
 #include "train/episodes.h"
 #include "train/evaluation.h"
+#include "train/experiment.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -62,7 +65,7 @@ struct TrainOptions {
   // Overrides, by name, over the learner's defaults and what the env's family trains it with
   // (train/sami/sami_train.h's sami_presets: SaMI's learners on an env by id).
   std::map<std::string, std::string> hyperparameters;
-  int eval_episodes = 2;                               // 0: no final evaluation
+  int eval_episodes = 2;  // 0: no final evaluation
   int eval_duration = 1000;
   bool eval_render = true;
   // Also evaluate the random policy the same way (same seeds, no video) into
@@ -76,6 +79,9 @@ struct TrainOptions {
   // options; `teacher` overrides the file's. Its book goes to <save_dir>/logs/teacher.jsonl.
   std::string task_space;
   std::string teacher;
+  // The curriculum itself instead of a task-space file (a family's own, e.g. TeachMyAgent's with
+  // its test set and shuffled dimensions); `teacher` still overrides its teacher.
+  std::optional<CurriculumSpec> curriculum;
   // A teacher object instead of a name (e.g. Python's, cradle.train(teacher=obj)): made once per
   // rank with the task space and the rank's seed; the file's teacher key may then be left out.
   TeacherFactory teacher_factory;
@@ -89,6 +95,18 @@ struct TrainOptions {
   // rank r > 0 logs its envs under <save_dir>/ranks/<r>/. The algorithms whose
   // learn::algorithm_traits say data_parallel.
   std::shared_ptr<learn::GradSync> sync;
+  // An experiment's evaluations, files and state (train/experiment.h; e.g. TeachMyAgent's student
+  // run). Its evaluations place the checkpoints: checkpoint_every is then unused.
+  std::shared_ptr<Experiment> experiment;
+  // > 0: a fresh learner (networks, optimiser, buffer; the k-th seeded seed + 7919 k) every this
+  // many env steps, the run's step count going on (TeachMyAgent's student resets).
+  long reset_every = 0;
+  // false: only the newest checkpoints/step_<n>.ckpt is kept (a replay buffer makes each large).
+  bool keep_step_checkpoints = true;
+  // Options of the env maker (envs::env_maker), e.g. a TeachMyAgent body's motors_torque.
+  envs::EnvOptions env_options;
+  // Keys written into a fresh run's run.json beside the run's own (e.g. a front end's arguments).
+  nlohmann::ordered_json run_json = nlohmann::ordered_json::object();
 };
 
 struct TrainResult {

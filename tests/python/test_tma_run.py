@@ -51,7 +51,7 @@ def test_a_finished_run_resumes_and_is_not_replaced(tmp_path):
                 hyperparameters=TINY, out=out)
     tma.run(**args)
     before = (tmp_path / "run" / "progress.csv").read_text()
-    with pytest.raises(ValueError, match="holds a run; give --resume"):
+    with pytest.raises(ValueError, match="holds a run .*: give --resume"):
         tma.run(**args)
     assert (tmp_path / "run" / "progress.csv").read_text() == before
     args["steps"] = 900

@@ -414,7 +414,7 @@ TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
   const fs::path run = results / "ALP-GMM_criterion_1_allow_expert_knowledge_none" /
                        "ALP-GMM_criterion_1_allow_expert_knowledge_none_s1";
   for (const char* f : {"run.json", "progress.csv", "test_returns.csv", "test_set.csv",
-                        "teacher.jsonl", "launch.json", "finished"}) {
+                        "logs/teacher.jsonl", "launch.json", "finished"}) {
     EXPECT_TRUE(fs::exists(run / f)) << f;
   }
   std::ifstream in(run / "run.json");

@@ -1,5 +1,6 @@
-// `cradle tma run`: tiny runs of both students write the run folder of docs/tma_run.md, resume
-// continues every file from the checkpoint, and bad input is a one-line error.
+// `cradle tma run`: tiny runs of both students write the run folder of docs/tma_run.md (through
+// the one run, train::train), resume continues every file from the checkpoint, and bad input is a
+// one-line error.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -90,8 +91,8 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_EQ(set[0], "task_index,stump_height,obstacle_spacing");
   EXPECT_EQ(set[4], "3,3,6");
 
-  // teacher.jsonl: one train line per episode (in order), a dump per evaluation.
-  std::vector<nlohmann::json> book = jsonl(dir / "teacher.jsonl");
+  // logs/teacher.jsonl: one train line per episode (in order), a dump per evaluation.
+  std::vector<nlohmann::json> book = jsonl(dir / "logs" / "teacher.jsonl");
   long train = 0, dumps = 0;
   for (const nlohmann::json& j : book) {
     if (j["kind"] == "train") {
@@ -108,7 +109,11 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   }
   EXPECT_EQ(train, episodes);
   EXPECT_EQ(dumps, 3);
-  EXPECT_TRUE(fs::exists(dir / "checkpoints" / "latest.ckpt"));
+  // The run's own files: a progress row per report, the checkpoints of the last evaluation.
+  EXPECT_EQ(read_lines(dir / "logs" / "progress.csv").size(), 3u);  // reports at 1000 and 2000
+  for (const char* file : {"latest.ckpt", "final.ckpt", "step_2000.ckpt"})
+    EXPECT_TRUE(fs::exists(dir / "checkpoints" / file)) << file;
+  EXPECT_FALSE(fs::exists(dir / "checkpoints" / "step_1000.ckpt"));  // only the newest kept
 
   // A row written after the checkpoint (a crash) is cut off on resume and kept aside.
   std::ofstream(dir / "progress.csv", std::ios::app) << "9,9999,1,1,1,1,1,1,1\n";
@@ -122,7 +127,7 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_GE(std::stol(cells(progress[4])[2]), episodes);
   EXPECT_EQ(read_lines(dir / "test_returns.csv").size(), 1u + 4 * 4);
   train = 0;
-  for (const nlohmann::json& j : jsonl(dir / "teacher.jsonl")) {
+  for (const nlohmann::json& j : jsonl(dir / "logs" / "teacher.jsonl")) {
     if (j["kind"] == "train") {
       EXPECT_EQ(j["episode"], train++);
     }
@@ -136,109 +141,73 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_NE(r.out.find("cradle: error: --resume: --teacher"), std::string::npos) << r.out;
 }
 
-TEST(TmaRun, ResumeAdoptsAnOlderBinarysColumns) {
+// A log of other columns (another version's) is kept whole beside a fresh one on resume, never
+// mixed with the current columns; the evaluations go on being numbered.
+TEST(TmaRun, ResumeKeepsALogOfOtherColumnsAside) {
   const fs::path dir = fresh("cradle_tma_run_old_header");
   const std::string args = kSac + "--teacher Random --out " + dir.string();
   RunResult r = run_cradle(args + " --nb_env_steps 0.002");
   ASSERT_EQ(r.status, 0) << r.out;
-
-  // As an older binary wrote them: progress.csv without the timing columns, test_returns.csv
-  // with a column the current binary does not know; the checkpoint names those files' sizes.
-  const fs::path state_file = dir / "checkpoints" / "latest.json";
-  nlohmann::json state = nlohmann::json::parse(std::ifstream(state_file));
-  std::vector<std::string> old_rows;
-  {
-    std::ostringstream text;
-    for (const std::string& line : read_lines(dir / "progress.csv")) {
-      std::string cut = line;
-      for (int k = 0; k < 2; ++k) cut.erase(cut.rfind(','));
-      old_rows.push_back(cut);
-      text << cut << "\n";
-    }
-    std::ofstream(dir / "progress.csv", std::ios::trunc) << text.str();
-  }
-  ASSERT_EQ(old_rows.size(), 4u);
-  ASSERT_EQ(old_rows[0],
-            "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
-            "pct_mastered,mean_train_return");
   std::vector<std::string> old_tests = read_lines(dir / "test_returns.csv");
-  old_tests[0] = "evaluation,env_steps,task_index,return,solved";
+  old_tests[0] = "evaluation,env_steps,task_index,return,achieved";  // as long as the header
   {
     std::ofstream out(dir / "test_returns.csv", std::ios::trunc);
     for (const std::string& line : old_tests) out << line << "\n";
   }
-  state["sizes"]["progress.csv"] = fs::file_size(dir / "progress.csv");
-  state["sizes"]["test_returns.csv"] = fs::file_size(dir / "test_returns.csv");
-  std::ofstream(state_file, std::ios::trunc) << state.dump(2) << "\n";
-
   r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("progress.csv: rows of an older header rewritten"), std::string::npos)
+  EXPECT_NE(r.out.find("test_returns.csv: written with other columns, kept whole as"),
+            std::string::npos)
       << r.out;
-
-  // One CSV, one column count: the old rows under the current header with empty timing cells,
-  // then the resumed run's row with its own.
-  const std::vector<std::string> progress = read_lines(dir / "progress.csv");
-  ASSERT_EQ(progress.size(), 5u);
-  EXPECT_EQ(progress[0],
-            "evaluation,env_steps,episodes,wall_s,sps,mean_test_return,std_test_return,"
-            "pct_mastered,mean_train_return,gradient_steps,teacher_s");
-  for (const std::string& line : progress) {
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 10) << line;
-  }
-  for (int k = 1; k < 4; ++k) EXPECT_EQ(progress[k], old_rows[k] + ",,") << k;
-  EXPECT_EQ(cells(progress[4])[0], "3");
-  EXPECT_EQ(cells(progress[4])[1], "3000");
-  EXPECT_FALSE(cells(progress[4]).back().empty());  // teacher_s
-
-  // A column that would be lost: the old file is kept whole beside, and its rows go on under the
-  // current header (the unknown column left out), so the evaluations stay numbered 0, 1, 2, 3.
   EXPECT_EQ(read_lines(dir / "test_returns.before-resume.csv"), old_tests);
   const std::vector<std::string> tests = read_lines(dir / "test_returns.csv");
-  ASSERT_EQ(tests.size(), 1u + 4 * 4);
+  ASSERT_EQ(tests.size(), 1u + 4);
   EXPECT_EQ(tests[0], "evaluation,env_steps,task_index,return,mastered");
-  for (int k = 1; k <= 12; ++k) {
-    EXPECT_EQ(tests[k], old_tests[k].substr(0, old_tests[k].rfind(',') + 1)) << k;
-  }
-  for (int k = 0; k < 4; ++k) EXPECT_EQ(cells(tests[1 + 4 * k])[0], std::to_string(k));
-
-  // The checkpoint now names the rewritten files' sizes: resuming again cuts nothing.
-  r = run_cradle(args + " --nb_env_steps 0.003 --resume");
-  ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_FALSE(fs::exists(dir / "progress.after-checkpoint.csv"));
-  EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
+  EXPECT_EQ(cells(tests[1])[0], "3");
+  EXPECT_EQ(cells(tests[1])[1], "3000");
+  // progress.csv had the current columns: it goes on.
+  EXPECT_EQ(read_lines(dir / "progress.csv").size(), 5u);
 }
 
-// The resume point is one atomic step: a kill after the next checkpoint was written but before
-// latest.json named it (simulated by putting the earlier latest.json and step file back) still
-// resumes, from the earlier evaluation, to the same files as an uninterrupted run.
-TEST(TmaRun, AKillBetweenCheckpointAndResumePointStillResumes) {
+// A run killed after a checkpoint (its folder put back as the checkpoint left it, later rows and
+// all) resumes to the same files as the run that went on from that checkpoint undisturbed.
+TEST(TmaRun, AKillAfterACheckpointResumesToTheSameFiles) {
   const fs::path dir = fresh("cradle_tma_run_atomic");
   const std::string args = kSac + "--teacher Random --out " + dir.string();
   ASSERT_EQ(run_cradle(args + " --nb_env_steps 0.002").status, 0);
-  const fs::path ckpts = dir / "checkpoints";
-  EXPECT_TRUE(fs::exists(ckpts / "step_2000.ckpt"));
-  EXPECT_EQ(fs::file_size(ckpts / "step_2000.ckpt"), fs::file_size(ckpts / "latest.ckpt"));
   const fs::path saved = fresh("cradle_tma_run_atomic_saved");
-  fs::create_directories(saved);
-  fs::copy(ckpts / "latest.json", saved / "latest.json");
-  fs::copy(ckpts / "step_2000.ckpt", saved / "step_2000.ckpt");
+  fs::copy(dir, saved, fs::copy_options::recursive);
 
   ASSERT_EQ(run_cradle(args + " --nb_env_steps 0.003 --resume").status, 0);
-  const std::vector<std::string> uninterrupted = read_lines(dir / "test_returns.csv");
-  EXPECT_FALSE(fs::exists(ckpts / "step_2000.ckpt"));  // only the last step file is kept
-  EXPECT_TRUE(fs::exists(ckpts / "step_3000.ckpt"));
+  EXPECT_FALSE(fs::exists(dir / "checkpoints" / "step_2000.ckpt"));  // only the newest is kept
+  EXPECT_TRUE(fs::exists(dir / "checkpoints" / "step_3000.ckpt"));
+  const std::vector<std::string> test_returns = read_lines(dir / "test_returns.csv");
+  const std::vector<std::string> book = read_lines(dir / "logs" / "teacher.jsonl");
+  std::vector<std::string> progress;  // without the timing columns (wall_s, sps, teacher_s)
+  for (const std::string& line : read_lines(dir / "progress.csv")) {
+    const std::vector<std::string> c = cells(line + ",");
+    progress.push_back(c[0] + c[1] + c[2] + c[5] + c[6] + c[7] + c[8] + c[9]);
+  }
 
-  // latest.ckpt is of 3000 steps, latest.json of 2000: the step file it names is used.
-  fs::copy(saved / "latest.json", ckpts / "latest.json", fs::copy_options::overwrite_existing);
-  fs::copy(saved / "step_2000.ckpt", ckpts / "step_2000.ckpt");
+  // The checkpoint of 2000 steps back, with the files as a kill after 3000 steps left them.
+  fs::remove_all(dir / "checkpoints");
+  fs::copy(saved / "checkpoints", dir / "checkpoints", fs::copy_options::recursive);
   const RunResult r = run_cradle(args + " --nb_env_steps 0.003 --resume");
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_EQ(read_lines(dir / "test_returns.csv"), uninterrupted);
-  EXPECT_EQ(cells(read_lines(dir / "progress.csv").back())[0], "3");
+  EXPECT_EQ(read_lines(dir / "test_returns.csv"), test_returns);
+  EXPECT_EQ(read_lines(dir / "logs" / "teacher.jsonl"), book);
+  std::vector<std::string> again;
+  for (const std::string& line : read_lines(dir / "progress.csv")) {
+    const std::vector<std::string> c = cells(line + ",");
+    again.push_back(c[0] + c[1] + c[2] + c[5] + c[6] + c[7] + c[8] + c[9]);
+  }
+  EXPECT_EQ(again, progress);
+  // What the first resume wrote after the checkpoint is kept aside, not lost.
+  EXPECT_EQ(read_lines(dir / "test_returns.after-checkpoint.csv").size(), 4u);
+  fs::remove_all(saved);
 }
 
-// A finished run is never replaced silently; --overwrite replaces it; a damaged resume point or
+// A finished run is never replaced silently; --overwrite replaces it; a damaged checkpoint or
 // teacher book is a one-line error naming the file, and nothing in the folder changes.
 TEST(TmaRun, FinishedRunsAndDamagedFilesAreRefused) {
   const fs::path dir = fresh("cradle_tma_run_refuse");
@@ -248,8 +217,8 @@ TEST(TmaRun, FinishedRunsAndDamagedFilesAreRefused) {
   const std::vector<std::string> progress = read_lines(dir / "progress.csv");
   RunResult r = run_cradle(args);
   EXPECT_EQ(r.status, 1) << r.out;
-  EXPECT_NE(r.out.find("holds a run; give --resume to continue it, --overwrite"), std::string::npos)
-      << r.out;
+  EXPECT_NE(r.out.find("holds a run ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("): give --resume to continue it, --overwrite"), std::string::npos) << r.out;
   EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
 
   auto one_line_naming = [](const RunResult& res, const std::string& what) {
@@ -257,31 +226,38 @@ TEST(TmaRun, FinishedRunsAndDamagedFilesAreRefused) {
     EXPECT_EQ(std::count(res.out.begin(), res.out.end(), '\n'), 1) << res.out;
     EXPECT_NE(res.out.find(what), std::string::npos) << res.out;
   };
-  const fs::path state = dir / "checkpoints" / "latest.json";
-  const std::vector<std::string> good_state = read_lines(state);
+  const fs::path latest = dir / "checkpoints" / "latest.ckpt";
+  const fs::path good = dir / "good.ckpt";
+  fs::copy_file(latest, good);
   const std::string resume = run_args + " --nb_env_steps 0.002 --resume";
-  for (const char* bad : {"[]", "{\"env_steps\": \"x\"}", "{", "\x01\x02garbage"}) {
-    std::ofstream(state, std::ios::trunc) << bad;
-    one_line_naming(run_cradle(resume), "latest.json");
+  for (const char* bad : {"[]", "{", "\x01\x02garbage"}) {
+    fs::remove(latest);
+    std::ofstream(latest, std::ios::trunc) << bad;
+    one_line_naming(run_cradle(resume), "latest.ckpt");
     EXPECT_EQ(read_lines(dir / "progress.csv"), progress) << bad;
   }
-  {
-    std::ofstream out(state, std::ios::trunc);
-    for (const std::string& l : good_state) out << l << "\n";
-  }
-  const std::vector<std::string> book = read_lines(dir / "teacher.jsonl");
+  // A run folder of an earlier Cradle (its resume point in latest.json).
+  fs::remove(latest);
+  fs::copy_file(good, latest);
+  std::ofstream(dir / "checkpoints" / "latest.json") << "{}";
+  one_line_naming(run_cradle(resume), "written by an earlier Cradle (checkpoints/latest.json)");
+  fs::remove(dir / "checkpoints" / "latest.json");
+  fs::remove(good);
+  const fs::path book_file = dir / "logs" / "teacher.jsonl";
+  const std::vector<std::string> book = read_lines(book_file);
   for (const char* bad :
        {"{\"env_steps\": 3}", "{\"kind\": \"train\", \"task\": [1]}", "{\"kind\": \"nonsense\"}"}) {
     {
-      std::ofstream out(dir / "teacher.jsonl", std::ios::trunc);
+      std::ofstream out(book_file, std::ios::trunc);
       out << bad << "\n";
       for (const std::string& l : book) out << l << "\n";
     }
     one_line_naming(run_cradle(resume), "teacher.jsonl:1: ");
     EXPECT_EQ(read_lines(dir / "progress.csv"), progress) << bad;
+    EXPECT_EQ(read_lines(book_file).size(), book.size() + 1) << bad;
   }
   {
-    std::ofstream out(dir / "teacher.jsonl", std::ios::trunc);
+    std::ofstream out(book_file, std::ios::trunc);
     for (const std::string& l : book) out << l << "\n";
   }
   // An output path that cannot be a folder.
@@ -307,10 +283,11 @@ TEST(TmaRun, PpoStudentWithStudentReset) {
   const std::vector<std::string> progress = read_lines(dir / "progress.csv");
   ASSERT_EQ(progress.size(), 4u);
   EXPECT_EQ(cells(progress[3])[1], "1000");
-  const nlohmann::json state =
-      nlohmann::json::parse(std::ifstream(dir / "checkpoints" / "latest.json"));
-  EXPECT_EQ(state["student_resets"], 1);
-  EXPECT_EQ(state["step_offset"], 500);
+  // The checkpoint's run state: one fresh student, from step 500 on.
+  std::ifstream in(dir / "checkpoints" / "latest.ckpt", std::ios::binary);
+  const std::string ckpt((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(ckpt.find("\"learner_resets\":1"), std::string::npos);
+  EXPECT_NE(ckpt.find("\"step_offset\":500"), std::string::npos);
   const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
   EXPECT_EQ(summary["env_steps"], 1000);
   // The preset's return statistics are in the checkpoint: the run resumes with them.
@@ -334,7 +311,7 @@ TEST(TmaRun, InterruptStopsAtAReportAndResumes) {
   const long checkpoint = summary["checkpoint_env_steps"].get<long>();
   EXPECT_EQ(checkpoint % 1000, 0);
   EXPECT_LT(checkpoint, 1'000'000);
-  // --resume goes on from the last evaluation's checkpoint to one evaluation more.
+  // --resume goes on from the checkpoint written where it stopped to one evaluation more.
   const std::string target = std::to_string((checkpoint + 1000) / 1e6);
   r = run_cradle(args + " --nb_env_steps " + target + " --resume");
   ASSERT_EQ(r.status, 0) << r.out;

@@ -244,7 +244,8 @@ DAMAGE = {
     "run_json_cut": ("run.json", _cut, "is not valid JSON"),
     "launch_json_list": ("launch.json", lambda p: p.write_text("[1, 2]\n"),
                          "is not a JSON object"),
-    "teacher_jsonl_cut": ("teacher.jsonl", lambda p: _cut(p, 40), "line 1 is not a teacher record"),
+    "teacher_jsonl_cut": ("logs/teacher.jsonl", lambda p: _cut(p, 40),
+                          "line 1 is not a teacher record"),
 }
 
 

@@ -1,25 +1,22 @@
-// A TeachMyAgent student run (`cradle tma run`, the reference's run.py): one learner (SAC or PPO
-// with the reference presets) trained on envs whose tasks a teacher picks, evaluated every
-// test_every env steps on a test set with the deterministic policy. The env family comes in
-// through factories, so this run knows only envs::Env; it trains through the shared loop
-// (train/loop.h) and evaluates with the shared rollout (train/episodes.h). Writes the run folder of
-// docs/tma_run.md: run.json, progress.csv, test_returns.csv, test_set.csv, teacher.jsonl,
-// checkpoints/ (step_<N>.ckpt and latest.ckpt of the last evaluation, latest.json naming it).
+// A TeachMyAgent student run (`cradle tma run`, the reference's run.py) on the one run path
+// (train::train): one student (SAC or PPO with the reference presets) trained on one env of
+// TeachMyAgent's benchmark whose tasks a teacher picks, evaluated every test_every env steps on a
+// test set with the deterministic policy. This file holds the benchmark's facts (task spaces,
+// return bounds, easy corner, test sets, student presets) and the evaluations as the run's
+// experiment (train/experiment.h); folder, curriculum, student resets, checkpoints and resume are
+// the run's. The run folder (docs/tma_run.md): run.json, progress.csv (one row per evaluation),
+// test_returns.csv, test_set.csv, summary.json, logs/progress.csv (one row per report),
+// logs/teacher.jsonl, checkpoints/{step_<N>,latest,final}.ckpt (N: the newest evaluation's step).
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <map>
-#include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "envs/env.h"
-#include "learn/learner.h"
 #include "teach/controller.h"
 #include "teach/registry.h"
 #include "tma/physics.h"
@@ -27,9 +24,8 @@
 
 namespace cradle::train {
 
-// What the env family brings: envs, the task space and the facts of its benchmark.
+// What the benchmark says of one of its envs: the task space and the facts of its experiments.
 struct StudentEnv {
-  std::function<std::unique_ptr<envs::Env>()> make;  // a fresh env (training or test)
   teach::TaskSpace space;
   double reward_lb = -100, reward_ub = 100;         // return bounds for reward scaling
   double success_threshold = tma::kSuccessReturn;   // return above which a task is mastered
@@ -37,30 +33,7 @@ struct StudentEnv {
   std::vector<teach::Task> test_set;                // empty: teach::default_test_set
 };
 
-struct StudentRunOptions {
-  std::string student = "sac";  // "sac" or "ppo" (the reference presets)
-  std::string teacher = "ALP-GMM";
-  nlohmann::json teacher_params = nlohmann::json::object();
-  std::string expert_knowledge = "high";  // the reference's default ("original")
-  long total_steps = 20'000'000;
-  long test_every = 500'000;  // env steps between evaluations
-  int nb_test_episodes = 100;
-  std::uint64_t seed = 0;
-  long keep_periodical_task_samples = 0;  // 0: no curriculum snapshots
-  bool shuffle_dimensions = false;
-  bool scale_reward = false;
-  long reset_frequency = 0;  // > 0: a fresh student every this many env steps (criterion 3)
-  std::map<std::string, std::string> hyperparameters;  // over the preset
-  std::filesystem::path out;
-  bool resume = false;
-  bool overwrite = false;  // replace a run already in `out` (without it or resume: refused)
-  bool progress_bar = true;
-  // Written into run.json beside the parsed values (the command line's arguments as given).
-  nlohmann::ordered_json arguments = nlohmann::ordered_json::object();
-  std::string commit = "unknown";
-  const std::atomic<bool>* stop = nullptr;  // set (e.g. by Ctrl-C) to stop at the next report
-};
-
+// What a student run did (this process's figures; the run's steps and episodes in total).
 struct StudentRunResult {
   long env_steps = 0;
   long episodes = 0;
@@ -94,16 +67,12 @@ StudentEnv tma_student_env(const tma::TmaOptions& options, const TmaBenchmark& b
 // student.
 std::map<std::string, std::string> student_preset(const std::string& student, long total_steps);
 
-// Runs (or with options.resume continues) a student run into options.out. UserError for a bad
-// option, an unknown teacher or student, or a resume whose arguments differ from run.json's.
-StudentRunResult run_student(const StudentEnv& env, const StudentRunOptions& options);
-
 // The most --nb_env_steps (millions) a run may ask for: the paper's runs are 20.
 constexpr double kTmaMaxMillions = 1000;
 
 // `cradle tma run`'s arguments, by run.py's names, as the CLI and Python give them: run_tma
-// checks them, records them in run.json (a resume compares them) and runs the student on
-// TeachMyAgent's benchmark env.
+// checks them, records them in run.json (a resume compares them) and trains the student on
+// TeachMyAgent's benchmark env through train::train.
 struct TmaRunArguments {
   std::string exp_name = "test", env = "stump-tracks", body = "old_classic_bipedal";
   std::string student = "sac", teacher = "ALP-GMM", expert_knowledge = "high", test_set, out;
