@@ -25,6 +25,7 @@
 #include "apps/bench_report.h"
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/distributed_flags.h"
 #include "apps/interrupt.h"
 #include "apps/tma_bench.h"
 #include "core/error.h"
@@ -132,6 +133,7 @@ struct RunOptions {
   train::TmaRunArguments a;
   bool no_progress = false;
   EnvFlags env_flags;
+  DistributedFlags dist;
 };
 
 // The environment and embodiment options of `random` and `run`.
@@ -305,6 +307,7 @@ void register_tma(CLI::App& app) {
   run->add_flag("--resume", rn->a.resume, "Continue the run in --out from its last checkpoint");
   run->add_flag("--overwrite", rn->a.overwrite, "Replace the run already in --out");
   run->add_flag("--no-progress", rn->no_progress, "No progress bar");
+  add_distributed_flags(run, rn->dist);
   run->callback([rn] {
     train::TmaRunArguments a = rn->a;
     a.progress_bar = !rn->no_progress;
@@ -312,9 +315,17 @@ void register_tma(CLI::App& app) {
     a.commit = source_commit();
     // Ctrl-C or a scheduler's SIGTERM ends the run at its next report instead of killing it.
     a.stop = stop_on({SIGINT, SIGTERM});
-    const train::TmaRun run = train::run_tma(a);
+    train::TmaRun run;
+    const int rank = run_as_rank(rn->dist, [&](std::shared_ptr<learn::GradSync> sync) {
+      a.sync = std::move(sync);
+      run = train::run_tma(a);
+      a.sync.reset();  // the ranks' group ends with this call
+      return run.parameter_hash;
+    });
     const train::StudentRunResult& r = run.result;
     const std::filesystem::path& out = run.out;
+    if (r.stopped && rank > 0) throw Stopped{};
+    if (rank > 0) return;  // rank 0 reports the run
     std::printf(
         "%s: %ld env steps, %ld episodes, %d evaluations, %.1f s, %.0f env steps/s, %.1f "
         "gradient steps/s, teacher %.2f%% of the time, %.0f%% mastered\n",

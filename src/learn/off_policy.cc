@@ -210,11 +210,6 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
   double collect_seconds = 0, update_seconds = 0;  // since the last report
   std::vector<long> episode_length(envs, 0);       // episode_train_freq: steps per env
   std::vector<std::uint8_t> episode_ended(envs, 0);
-  // Episode-end updates differ per rank, and every update is a collective: refused together.
-  if (config_.episode_train_freq > 0 && distributed(sync_.get()))
-    throw UserError(
-        "episode_train_freq > 0 cannot run distributed (ranks would update a different "
-        "number of times); use train_freq/gradient_steps");
   // Data-parallel: every rank continues from rank 0's networks.
   for (const auto& [key, module] : modules_) broadcast_module(sync_.get(), *module);
   for (const auto& [key, tensor] : tensors_) broadcast_tensor(sync_.get(), *tensor);
@@ -249,6 +244,10 @@ void OffPolicyLearner::learn(long total_steps, const ProgressFn& on_progress) {
         episode_length[e] = 0;
         episode_ended[e] = 1;
       }
+      // Every update is a collective: the ranks' episodes end apart, so at each step they agree
+      // on the most updates any rank's ended episodes ask for.
+      if (distributed(sync_.get()))
+        updates = static_cast<int>(agree_max(sync_.get(), static_cast<double>(updates)));
     }
     if (updates > 0 && ready_to_train()) run_updates(updates, pipeline_.normalizer());
     update_seconds += std::chrono::duration<double>(Clock::now() - update_start).count();

@@ -513,12 +513,13 @@ TmaRun run_tma(const TmaRunArguments& a) {
                              .keep_step_checkpoints = false,
                              .env_options = maker_options,
                              .run_json = run_json};
+  train_options.sync = a.sync;
   Config config = default_config();
   config.save_dir = out.string();
   const TrainResult trained = train(config, train_options);
   StudentRunResult result = evaluations->result();
   result.stopped = result.stopped && trained.steps < total_steps;
-  return {.out = out, .result = result};
+  return {.out = out, .result = result, .parameter_hash = trained.parameter_hash};
 }
 
 }  // namespace cradle::train

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,10 @@
 #include "teach/registry.h"
 #include "tma/physics.h"
 #include "tma/tma_env.h"
+
+namespace cradle::learn {
+class GradSync;
+}
 
 namespace cradle::train {
 
@@ -89,10 +94,14 @@ struct TmaRunArguments {
   std::map<std::string, std::string> env_options;
   std::string commit = "unknown";
   const std::atomic<bool>* stop = nullptr;
+  // A data-parallel run's ranks (docs/distributed.md): each its own training env and teacher
+  // (seed + rank, its book in ranks/<r>/logs/), one student; rank 0 evaluates and writes the run.
+  std::shared_ptr<learn::GradSync> sync;
 };
 struct TmaRun {
   std::filesystem::path out;  // the run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)
-  StudentRunResult result;
+  StudentRunResult result;    // rank 0's (the evaluations are rank 0's)
+  std::uint64_t parameter_hash = 0;  // the trained student's (every rank the same)
 };
 TmaRun run_tma(const TmaRunArguments& arguments);
 

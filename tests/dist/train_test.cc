@@ -156,6 +156,38 @@ TEST(LaunchSami, SamiTrainTwoRanksEndWithBitwiseIdenticalParameters) {
   fs::remove_all(dir);
 }
 
+// `cradle tma run` takes --distributed too: each rank its own Stump Tracks env and ALP-GMM teacher,
+// SAC with the reference's episode-end updates (the ranks agree on their count), rank 0
+// evaluating and writing the run; one student with the same networks on both ranks at the end.
+TEST(LaunchTma, TmaRunTwoRanksEndWithBitwiseIdenticalParameters) {
+  const fs::path dir = fresh_dir("dist_tma_run");
+  const RunResult r = run_cradle(
+      "launch --nproc 2 -- cradle tma run --env stump-tracks --student sac --teacher ALP-GMM "
+      "--steps 4000 --test_every 2000 --nb_test_episodes 3 --seed 3 --distributed "
+      "--dist-timeout 30 --no-progress --out " +
+      (dir / "run").string() +
+      " --hp learning_starts=1000 --hp batch_size=64 --hp pi_layers=32 --hp qf_layers=32");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::map<int, std::string> h = hashes(r.out);
+  ASSERT_EQ(h.size(), 2u) << r.out;
+  EXPECT_EQ(h.at(0), h.at(1));
+  // Evaluations 0, 1 and 2 by rank 0 (one report line); SAC updated before the end.
+  const std::vector<std::string> progress = read_lines(dir / "run" / "progress.csv");
+  ASSERT_EQ(progress.size(), 4u);
+  std::vector<std::string> cells;
+  std::stringstream row(progress[3]);
+  for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+  ASSERT_EQ(cells.size(), 11u) << progress[3];
+  EXPECT_EQ(cells[0], "2");
+  EXPECT_EQ(cells[1], "4000");
+  EXPECT_GT(std::stod(cells[9]), 0) << progress[3];  // gradient steps
+  EXPECT_EQ(r.out.find("env steps,"), r.out.rfind("env steps,")) << r.out;
+  // Each rank's teacher keeps its own book.
+  EXPECT_FALSE(read_lines(dir / "run" / "ranks" / "1" / "logs" / "teacher.jsonl").empty());
+  EXPECT_TRUE(fs::exists(dir / "run" / "checkpoints" / "final.ckpt"));
+  fs::remove_all(dir);
+}
+
 TEST(Launch, AFailingRankStopsTheOthersAndIsNamed) {
   const auto start = std::chrono::steady_clock::now();
   const RunResult r = run_cradle(
