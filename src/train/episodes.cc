@@ -2,22 +2,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <vector>
 
 namespace cradle::train {
 
-std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
-                                         std::span<const std::uint64_t> seeds, int max_steps,
-                                         const EpisodeStepFn& on_step,
-                                         const EpisodeStartFn& on_start) {
+namespace {
+
+// Plays `count` episodes, episode e reset with seed_of(e) (none: the env's own stream).
+std::vector<EpisodeOutcome> play(
+    envs::Env& env, const EpisodePolicy& policy, std::size_t count,
+    const std::function<std::optional<std::uint64_t>(std::size_t)>& seed_of, int max_steps,
+    const EpisodeStepFn& on_step, const EpisodeStartFn& on_start) {
   std::vector<double> action(env.action_space().size());
   const int success = env.info().find("is_success");
   const int failure = env.info().find("is_failure");
   std::vector<EpisodeOutcome> out;
-  for (size_t e = 0; e < seeds.size(); ++e) {
-    EpisodeOutcome r{.seed = seeds[e]};
+  for (size_t e = 0; e < count; ++e) {
+    const std::optional<std::uint64_t> seed = seed_of(e);
+    EpisodeOutcome r{.seed = seed.value_or(0)};
     if (on_start) on_start(static_cast<int>(e), env);
-    env.reset(seeds[e]);
+    env.reset(seed);
     if (policy.new_episode) policy.new_episode();
     while (true) {
       policy.act(env.observation(), action);
@@ -37,6 +43,25 @@ std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& po
     out.push_back(r);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
+                                         std::span<const std::uint64_t> seeds, int max_steps,
+                                         const EpisodeStepFn& on_step,
+                                         const EpisodeStartFn& on_start) {
+  return play(
+      env, policy, seeds.size(), [&](std::size_t e) { return std::optional(seeds[e]); }, max_steps,
+      on_step, on_start);
+}
+
+std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy, int episodes,
+                                         int max_steps, const EpisodeStepFn& on_step,
+                                         const EpisodeStartFn& on_start) {
+  return play(
+      env, policy, static_cast<std::size_t>(std::max(episodes, 0)),
+      [](std::size_t) { return std::optional<std::uint64_t>(); }, max_steps, on_step, on_start);
 }
 
 nlohmann::ordered_json episodes_json(const std::vector<EpisodeOutcome>& episodes) {

@@ -42,6 +42,12 @@ std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& po
                                          std::span<const std::uint64_t> seeds, int max_steps = 0,
                                          const EpisodeStepFn& on_step = nullptr,
                                          const EpisodeStartFn& on_start = nullptr);
+// The same for `episodes` episodes that go on with the env's own random stream (each reset
+// without a seed, the outcomes' seed 0): SaMI's evaluation, whose env draws every episode's task
+// from the stream of its one seed.
+std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy, int episodes,
+                                         int max_steps = 0, const EpisodeStepFn& on_step = nullptr,
+                                         const EpisodeStartFn& on_start = nullptr);
 
 // The results as evaluation.json writes them: per episode, then mean and std of the return,
 // the mean length and the success rate.

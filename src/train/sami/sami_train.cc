@@ -26,6 +26,7 @@
 #include "sami/render.h"
 #include "sami/task.h"
 #include "train/env_vector.h"
+#include "train/episodes.h"
 #include "train/loop.h"
 #include "train/run_json.h"
 #include "train/trainer.h"
@@ -313,47 +314,48 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
       }
     }
     SamiCell cell{.name = cell_name(sets[s], panda)};
+    // The cell's episodes through the one rollout, each going on with the env's own stream. After
+    // every step: the context the learner acted with and the step's task and skill (every
+    // context_every-th step), the first episode's frame; at the episode's end its skill labels
+    // the rows and counts in the cell's mix.
+    learn::Learner* l = learner.get();
+    std::string episode_task;
+    const std::vector<EpisodeOutcome> episodes = run_episodes(
+        adapter,
+        {.act = [l](const envs::ObservationBuffers& obs,
+                    std::span<double> a) { l->act(obs, a, /*deterministic=*/true); },
+         .new_episode = [l] { l->new_episode(); }},
+        options.episodes, 0, [&](int e, const envs::Env&, const envs::StepResult& r) {
+          const sami::Info& info = env.info();
+          const int step = info.steps - 1;
+          // The parameters this episode drew (the task, within its task set): mass, damping, the
+          // crippled joints ("0+4"; "none").
+          if (step == 0) {
+            episode_task = csv_cell(info.mass) + "," + csv_cell(info.damping) + "," +
+                           (info.crippled.empty() ? "none" : sami::joints_text(info.crippled, "+"));
+          }
+          if (step % context_every == 0) {
+            const std::span<const float> c = learn::meta::last_context(*l);
+            episode_rows.push_back(std::to_string(s) + ",\"" + cell.name + "\"," +
+                                   std::to_string(e) + "," + std::to_string(step) + "," +
+                                   episode_task + "," + std::string(sami::skill_name(info.skill)));
+            context_values.insert(context_values.end(), c.begin(), c.end());
+          }
+          if (renderer && e == 0) {
+            renderer->render(env, frame);
+            video->write(frame);
+          }
+          if (!r.terminated && !r.truncated) return;
+          const std::string episode_skill(sami::skill_name(info.episode_skill));
+          for (std::string& row : episode_rows) context_rows.push_back(row + "," + episode_skill);
+          episode_rows.clear();
+          cell.success_rate += info.is_success;
+          cell.push += info.episode_skill == sami::Skill::kPush;
+          cell.roll += info.episode_skill == sami::Skill::kRoll;
+          cell.pick_and_place += info.episode_skill == sami::Skill::kPickAndPlace;
+        });
     std::vector<double> episode_returns;
-    std::vector<double> action(spec.action_size);
-    for (int e = 0; e < options.episodes; ++e) {
-      adapter.reset();
-      learner->new_episode();
-      // The parameters this episode drew (the task, within its task set): mass, damping, the
-      // crippled joints ("0+4"; "none").
-      const sami::Info& drawn = env.info();
-      const std::string episode_task =
-          csv_cell(drawn.mass) + "," + csv_cell(drawn.damping) + "," +
-          (drawn.crippled.empty() ? "none" : sami::joints_text(drawn.crippled, "+"));
-      double ret = 0;
-      envs::StepResult r;
-      do {
-        learner->act(adapter.observation(), action, /*deterministic=*/true);
-        const std::span<const float> c = learn::meta::last_context(*learner);
-        const int step = env.info().steps;
-        r = adapter.step(action);
-        ret += r.reward;
-        if (step % context_every == 0) {
-          episode_rows.push_back(std::to_string(s) + ",\"" + cell.name + "\"," + std::to_string(e) +
-                                 "," + std::to_string(step) + "," + episode_task + "," +
-                                 std::string(sami::skill_name(env.info().skill)));
-          context_values.insert(context_values.end(), c.begin(), c.end());
-        }
-        if (renderer && e == 0) {
-          renderer->render(env, frame);
-          video->write(frame);
-        }
-      } while (!r.terminated && !r.truncated);
-      // The episode's label, known at its end, completes its context rows.
-      const std::string episode_skill(sami::skill_name(env.info().episode_skill));
-      for (std::string& row : episode_rows) context_rows.push_back(row + "," + episode_skill);
-      episode_rows.clear();
-      cell.success_rate += env.info().is_success;
-      const sami::Skill skill = env.info().episode_skill;
-      cell.push += skill == sami::Skill::kPush;
-      cell.roll += skill == sami::Skill::kRoll;
-      cell.pick_and_place += skill == sami::Skill::kPickAndPlace;
-      episode_returns.push_back(ret);
-    }
+    for (const EpisodeOutcome& o : episodes) episode_returns.push_back(o.episode_return);
     cell.episodes = options.episodes;
     const double k = options.episodes;
     all_success += cell.success_rate;
