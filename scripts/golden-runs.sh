@@ -114,7 +114,9 @@ for name in eval_touch eval_regard; do
 done
 for name in illustrate_ppo illustrate_a2c; do
   dir=$out/$name
-  for file in "$dir"/*; do echo "$name ${file#"$dir"/} $(digest "$file" "$dir")"; done
+  for file in $(cd "$dir" && find . -type f | sort); do
+    echo "$name ${file#./} $(digest "$dir/$file" "$dir")"
+  done
   grep -h 'test episodes' "$out/$name.log" | sed "s/^/$name /"
 done
 for name in tma_sac sami_TESAC sami_SaCCM; do

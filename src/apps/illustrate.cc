@@ -8,6 +8,8 @@
 // filming each episode, and prints the success rate and the mean return per episode. Without
 // --algorithm the algorithm is the --load_model checkpoint's; without either, testing takes
 // random actions (training then needs --algorithm).
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -24,16 +26,17 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/folders.h"
-#include "core/jsonl.h"
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
+#include "envs/registry.h"
 #include "eval/figures.h"
 #include "eval/video.h"
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
 #include "learn/vector_env.h"
+#include "train/episodes.h"
 #include "train/loop.h"
-#include "train/task_space.h"
+#include "train/trainer.h"
 
 namespace cradle::apps {
 namespace {
@@ -105,6 +108,24 @@ bool plot_curves(const Curves& c, const std::string& title, const fs::path& dir)
   return figures.draw(dir / "figures.json");
 }
 
+// A copy of a file in the temp folder, removed with the object.
+struct TempCopy {
+  explicit TempCopy(const fs::path& file)
+      : path(fs::temp_directory_path() /
+             ("cradle-illustrate-" + std::to_string(::getpid()) + "-" + file.filename().string())) {
+    std::error_code ec;
+    fs::copy_file(file, path, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw UserError("--load_model '" + file.string() + "' cannot be read: " + ec.message());
+  }
+  ~TempCopy() {
+    std::error_code ec;
+    fs::remove(path, ec);
+  }
+  TempCopy(const TempCopy&) = delete;
+  TempCopy& operator=(const TempCopy&) = delete;
+  fs::path path;
+};
+
 void run(const IllustrateOptions& o) {
   // Flags first, before anything is built.
   const std::string id = envs::sample_env_id(o.env);
@@ -145,64 +166,30 @@ void run(const IllustrateOptions& o) {
   const fs::path dir = fs::path("models") / o.env / o.save_model;
 
   // The reference passes the actuation model explicitly: muscles only with --use_muscles.
-  envs::SampleOptions env_options;
-  env_options.actuation = o.use_muscles ? ActuationModel::kMuscle : ActuationModel::kSpringDamper;
-  env_options.jitter = o.jitter;
-  env_options.position_inaccurate = o.position_inaccurate;
-  env_options.palm_up = o.palm_up;
-  const auto assets = envs::make_sample_assets(id, env_options);
-
-  // A curriculum: one teacher sets every training env's task options before its resets.
+  envs::EnvOptions env_options{{"actuation", o.use_muscles ? "muscle" : "spring_damper"}};
+  if (o.jitter) env_options["jitter"] = "true";
+  if (o.position_inaccurate) env_options["position_inaccurate"] = "true";
+  if (o.palm_up) env_options["palm_up"] = "true";
+  envs::env_maker(id, env_options);  // refuses a bad option before anything is written
   if (!o.teacher.empty() && o.task_space.empty())
     throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
-  std::optional<train::CurriculumSpec> spec;
-  std::shared_ptr<teach::TeacherController> curriculum;
-  if (!o.task_space.empty()) {
-    spec = train::load_task_space(o.task_space);
-    if (!o.teacher.empty()) spec->teacher = o.teacher;
-    curriculum = train::make_controller(*spec, o.seed);
-  }
 
-  // The learner trains on a vector of envs sharing the compiled scene.
-  std::unique_ptr<learn::ThreadedVecEnv> vec = std::make_unique<learn::ThreadedVecEnv>(
-      o.envs,
-      [&](int i) -> std::unique_ptr<envs::Env> {
-        auto env = envs::make_sample_env(assets, learn::ThreadedVecEnv::env_seed(o.seed, i));
-        if (!curriculum) return env;
-        return std::make_unique<train::CurriculumEnv>(std::move(env), curriculum,
-                                                      spec->env_options);
-      },
-      o.envs);
-  std::unique_ptr<learn::Learner> learner;
-  long successes = 0, ended = 0;  // training episodes, counted by the reward hook
-  if (o.train_for > 0 || !o.load_model.empty()) {
-    learn::LearnerOptions lo{.seed = o.seed, .hyperparameters = hyperparameters};
-    const int success = vec->info(0).find("is_success");
-    lo.reward_hook = [&, success](const learn::VecEnv& env, std::span<const double>,
-                                  std::span<double>) {
-      for (int i = 0; i < env.num_envs(); ++i) {
-        if (env.terminated()[i] || env.truncated()[i]) {
-          ++ended;
-          successes += env.info(i).flag(success);
-        }
-      }
-    };
-    learner = learn::make_learner(algorithm, *vec, lo);
-    if (!o.load_model.empty()) learner->load(o.load_model);
-    if (curriculum)  // SPDL values its tasks with the student's value function
-      curriculum->teacher().set_value_estimator(train::learner_value_estimator(
-          [&learner]() -> learn::Learner& { return *learner; }, vec->observation_space()));
-  }
-
-  // Training: checkpoints model_<k>.ckpt after every save_every steps, progress.csv per update.
+  // Training through the one run (train::train): the learner on a vector of envs sharing the
+  // compiled scene, a curriculum when given, a model every save_every steps saved from the
+  // progress report (one learn() call: episodes run on across saves, as the reference's
+  // callback saves) and named model_<k>.ckpt, progress.csv per update, learning curves.
+  train::CheckpointLearner tested;  // the policy tested below (none: random actions)
   if (o.train_for > 0) {
     std::error_code ec;
-    // --overwrite: the earlier run's models and curves go (after --load_model was read).
+    // A model of the folder that --overwrite clears is read from a copy taken first.
+    std::optional<TempCopy> staged;
+    if (!o.load_model.empty()) staged.emplace(o.load_model);
+    // --overwrite: the earlier run's models, curves and run files go.
     if (o.overwrite) {
       for (const auto& entry : fs::directory_iterator(dir, ec)) {
         const std::string name = entry.path().filename().string();
         if (name.starts_with("model_") || name == "progress.csv" || name.ends_with(".png") ||
-            name == "figures.json")
+            name == "figures.json" || name == "teacher.jsonl")
           fs::remove(entry.path(), ec);
       }
     }
@@ -211,21 +198,41 @@ void run(const IllustrateOptions& o) {
     if (!csv) throw UserError("cannot write '" + (dir / "progress.csv").string() + "'");
     csv << "global_step,time,charts/SPS,charts/episodic_return,charts/episodic_length,"
            "charts/success_rate,episodes\n";
-    const long first = learner->steps();
-    const long total = first + o.train_for;
-    long next_save = first + o.save_every;
+    const long first = staged ? learn::read_checkpoint_info(staged->path).steps : 0;
     int saved = 0;
-    long saved_at = first;
     long last_report = first;
     const auto start = Clock::now();
     std::printf("training %s on %s for %ld steps (%d envs) -> %s\n", algorithm.c_str(), id.c_str(),
                 o.train_for, o.envs, dir.c_str());
-    // Success rate of the episodes that ended since the last update.
-    long successes_seen = 0, ended_seen = 0;
+    // The success rate of the episodes that ended since the last update.
+    long successes = 0, ended = 0;
+    int success_flag = -1;
     Curves curves;
-    // The shared training loop; models are saved as the run goes (no boundaries, so one learn()
-    // call and the reference's episodes).
-    const auto report = [&](const learn::TrainStats& s) {
+    train::TrainOptions to{.env = id,
+                           .algorithm = algorithm,
+                           .intrinsic = "",
+                           .steps = first + o.train_for,
+                           .envs = o.envs,
+                           .threads = o.envs,
+                           .seed = o.seed,
+                           .overwrite = true,  // what --overwrite allows went above
+                           .checkpoint_every = o.save_every,
+                           .hyperparameters = hyperparameters,
+                           .eval_episodes = 0,
+                           .progress_bar = false,
+                           .task_space = o.task_space,
+                           .teacher = o.teacher};
+    to.reward_hook = [&](const learn::VecEnv& env, std::span<const double>, std::span<double>) {
+      if (success_flag < 0) success_flag = env.info(0).find("is_success");
+      for (int i = 0; i < env.num_envs(); ++i) {
+        if (env.terminated()[i] || env.truncated()[i]) {
+          ++ended;
+          successes += env.info(i).flag(success_flag);
+        }
+      }
+    };
+    long successes_seen = 0, ended_seen = 0;
+    to.on_report = [&](const learn::TrainStats& s) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
       const double rate = ended > ended_seen ? static_cast<double>(successes - successes_seen) /
                                                    static_cast<double>(ended - ended_seen)
@@ -239,103 +246,137 @@ void run(const IllustrateOptions& o) {
       curves.steps.push_back(static_cast<double>(s.steps));
       curves.returns.push_back(s.episodic_return);
       curves.success_rates.push_back(rate);
-      if (s.steps >= next_save) {
-        learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
-        saved_at = s.steps;
-        next_save += o.save_every;
-      }
-      if (s.steps - last_report >= std::max<long>(o.train_for / 20, 1) || s.steps >= total) {
+      if (s.steps - last_report >= std::max<long>(o.train_for / 20, 1) ||
+          s.steps >= first + o.train_for) {
         last_report = s.steps;
         std::printf("  %9ld steps  %6.0f s  %6.0f steps/s  return %s  length %s  success %s\n",
                     s.steps, elapsed, s.sps, csv_cell(s.episodic_return).c_str(),
                     csv_cell(s.episodic_length).c_str(), csv_cell(rate).c_str());
         std::fflush(stdout);
       }
-      return true;
     };
-    train::run_loop(*learner, {.total_steps = total, .report = report});
-    if (learner->steps() > saved_at) {
-      learner->save(dir / ("model_" + std::to_string(++saved) + ".ckpt"));
-    }
-    // The curriculum's book: every training episode's task and outcome, then the teacher's dump.
-    if (curriculum) {
-      JsonlWriter book(dir / "teacher.jsonl", /*append=*/false);
-      for (const teach::EpisodeRecord& e : curriculum->take_episodes())
-        book.write(teach::train_line(e));
-      book.write(teach::dump_line(curriculum->env_steps(), curriculum->teacher_dump()));
-      book.flush();
-      std::printf("curriculum: %ld episodes booked in %s\n", curriculum->episodes(),
-                  (dir / "teacher.jsonl").c_str());
-    }
+    // Each saved checkpoint is also model_<k>.ckpt, the reference's name (a hard link).
+    long saved_at = first;
+    auto name_model = [&](const fs::path& checkpoint, long steps) {
+      const fs::path model = dir / ("model_" + std::to_string(++saved) + ".ckpt");
+      std::error_code link_ec;
+      fs::remove(model, link_ec);
+      fs::create_hard_link(checkpoint, model, link_ec);
+      if (link_ec) fs::copy_file(checkpoint, model, fs::copy_options::overwrite_existing, link_ec);
+      if (link_ec) throw UserError("cannot write '" + model.string() + "': " + link_ec.message());
+      saved_at = steps;
+    };
+    to.on_checkpoint = [&](const fs::path& checkpoint) {
+      const std::string stem = checkpoint.stem().string();  // step_<n>
+      name_model(checkpoint, std::stol(stem.substr(stem.find('_') + 1)));
+    };
+    if (staged) to.load_model = staged->path.string();
+    to.checkpoints_split_learning = false;
+    Config config = default_config();
+    config.save_dir = dir.string();
+    const train::TrainResult trained = train::train(config, to);
+    // The last model, when the budget ends between saves.
+    if (trained.steps > saved_at) name_model(trained.checkpoint, trained.steps);
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    std::printf("trained %ld steps in %.0f s; last model: %s\n", learner->steps() - first, seconds,
+    std::printf("trained %ld steps in %.0f s; last model: %s\n", trained.steps - first, seconds,
                 (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
+    if (!o.task_space.empty()) {
+      std::printf("curriculum: training episodes booked in %s\n",
+                  (dir / "logs" / "teacher.jsonl").c_str());
+    }
     if (!curves.steps.empty() &&
         plot_curves(curves, id + " " + (o.algorithm.empty() ? algorithm : o.algorithm), dir)) {
       std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
     }
+    tested = train::load_learner(trained.checkpoint, id, env_options, hyperparameters, o.seed);
+  } else if (!o.load_model.empty()) {
+    tested = train::load_learner(o.load_model, id, env_options, hyperparameters, o.seed);
   }
-  // The vector stays alive: the learner keeps a reference to it.
 
-  // Testing: one env, the policy's deterministic action (random actions without a model).
+  // Testing: one env, the policy's deterministic action (random actions without a model), one
+  // rollout per episode until the step budget is spent.
   if (o.test_for == 0) return;
-  auto env = envs::make_sample_env(assets, o.seed + 1000);
+  envs::SampleOptions sample_options;
+  sample_options.actuation =
+      o.use_muscles ? ActuationModel::kMuscle : ActuationModel::kSpringDamper;
+  sample_options.jitter = o.jitter;
+  sample_options.position_inaccurate = o.position_inaccurate;
+  sample_options.palm_up = o.palm_up;
+  const std::unique_ptr<envs::MimoEnv> mimo =
+      envs::make_sample_env(envs::make_sample_assets(id, sample_options), o.seed + 1000);
+  envs::Env* env = mimo.get();
   const Box& space = env->action_space();
-  std::vector<double> action(space.size());
   Rng rng(o.seed + 2000);
-  std::vector<std::uint8_t> frame(static_cast<size_t>(env->render_size()) * env->render_size() * 3);
-  const double fps = 1.0 / (env->definition().frame_skip * env->model()->opt.timestep);
+  std::vector<std::uint8_t> frame(static_cast<size_t>(mimo->render_size()) * mimo->render_size() *
+                                  3);
+  const double fps = 1.0 / (mimo->definition().frame_skip * mimo->model()->opt.timestep);
   std::optional<eval::VideoWriter> video;
-  auto start_video = [&](int episode) {
-    if (!o.render_video) return;
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    video.emplace(dir / ("episode_" + std::to_string(episode) + ".mp4"), env->render_size(),
-                  env->render_size(), fps);
-    env->render(frame);
-    video->write(frame);
-  };
+  std::printf("testing %s for %ld steps with %s\n", id.c_str(), o.test_for,
+              !tested.learner ? "random actions"
+              : o.stochastic  ? "the trained policy (sampled actions)"
+                              : "the trained policy");
   struct Episode {
     double ret = 0;
     int length = 0;
     bool success = false;
   };
   std::vector<Episode> episodes;  // the ones that ended
-  Episode current;
-  start_video(0);
-  std::printf("testing %s for %ld steps with %s\n", id.c_str(), o.test_for,
-              !learner       ? "random actions"
-              : o.stochastic ? "the trained policy (sampled actions)"
-                             : "the trained policy");
-  for (long t = 0; t < o.test_for; ++t) {
-    if (learner) {
-      learner->act(env->observation(), action, /*deterministic=*/!o.stochastic);
-    } else {
-      space.sample(rng, action);
-    }
-    const envs::StepResult r = env->step(action);
-    current.ret += r.reward;
-    ++current.length;
-    current.success = env->success();
+  Episode cut;                    // the one the budget cut short
+  long left = o.test_for;
+  learn::Learner* l = tested.learner.get();
+  const train::EpisodePolicy policy{
+      .act =
+          [&](const envs::ObservationBuffers& obs, std::span<double> action) {
+            if (l) {
+              l->act(obs, action, /*deterministic=*/!o.stochastic);
+            } else {
+              space.sample(rng, action);
+            }
+          },
+      // A film per episode, from the state after its reset.
+      .new_episode =
+          [&] {
+            if (l) l->new_episode();
+            if (!o.render_video) return;
+            std::error_code ec;
+            fs::create_directories(dir, ec);
+            video.emplace(dir / ("episode_" + std::to_string(episodes.size()) + ".mp4"),
+                          mimo->render_size(), mimo->render_size(), fps);
+            mimo->render(frame);
+            video->write(frame);
+          }};
+  bool ended = false;  // the last step ended its episode (not the budget)
+  const auto on_step = [&](int, const envs::Env&, const envs::StepResult& r) {
+    ended = r.terminated || r.truncated;
     if (video) {
-      env->render(frame);
+      mimo->render(frame);
       video->write(frame);
     }
-    if (r.terminated || r.truncated) {
-      std::printf("  episode %zu: %d steps, return %.2f, %s\n", episodes.size(), current.length,
-                  current.ret, current.success ? "success" : "no success");
-      episodes.push_back(current);
-      current = {};
-      if (video) video->close();
-      if (t + 1 < o.test_for) {
-        env->reset();
-        start_video(static_cast<int>(episodes.size()));
-      }
+  };
+  // The first episode goes on from the env as made (reset with its seed again), the next ones
+  // with its own stream, as the reference's test loop resets.
+  const std::uint64_t first_seed = o.seed + 1000;
+  while (left > 0) {
+    const std::vector<train::EpisodeOutcome> played =
+        episodes.empty() && !cut.length
+            ? train::run_episodes(*env, policy, std::span(&first_seed, 1), static_cast<int>(left),
+                                  on_step)
+            : train::run_episodes(*env, policy, 1, static_cast<int>(left), on_step);
+    if (video) video->close();
+    const train::EpisodeOutcome& e = played.front();
+    left -= e.length;
+    const Episode done{.ret = e.episode_return, .length = e.length, .success = mimo->success()};
+    if (!ended) {
+      cut = done;
+      break;
     }
+    std::printf("  episode %zu: %d steps, return %.2f, %s\n", episodes.size(), done.length,
+                done.ret, done.success ? "success" : "no success");
+    episodes.push_back(done);
   }
   if (video) video->close();
   // An episode cut short by the end of testing counts only when none ended.
-  if (episodes.empty()) episodes.push_back(current);
+  if (episodes.empty()) episodes.push_back(cut);
   double returns = 0;
   int successes_test = 0;
   for (const Episode& e : episodes) {

@@ -207,10 +207,17 @@ EnvMaker mimo_maker(const std::string& registered, const EnvOptions& options) {
         throw UserError("env option actuation = '" + value +
                         "' (expected spring_damper or muscle)");
       }
+    } else if (name == "jitter" || name == "position_inaccurate" || name == "palm_up") {
+      // Catch's variants (`cradle illustrate --jitter` ...).
+      if (value != "true" && value != "false")
+        throw UserError("env option " + name + " = '" + value + "' (expected true or false)");
+      (name == "jitter"    ? so.jitter
+       : name == "palm_up" ? so.palm_up
+                           : so.position_inaccurate) = value == "true";
     } else {
       throw UserError("env option '" + name +
-                      "' is not one MIMo sample envs take (expected "
-                      "actuation)");
+                      "' is not one MIMo sample envs take (expected actuation, jitter, "
+                      "position_inaccurate or palm_up)");
     }
   }
   auto assets = make_sample_assets(registered, so);

@@ -1,7 +1,8 @@
-// The training loop every run shares (`cradle train`, `cradle illustrate`, `cradle tma run`):
-// learn() in intervals that end at boundaries (checkpoints, evaluations, student resets: each
-// learn() call starts fresh episodes, so a boundary is an episode boundary, as in a resumed run),
-// a report after every update, and the progress bar and progress.csv cells the runs print.
+// The training loop of the one run (train::train, under `cradle train`, `cradle illustrate`,
+// `cradle tma run`, `cradle sami train` and Python's): learn() in intervals that end at boundaries
+// (checkpoints, evaluations, student resets: each learn() call starts fresh episodes, so a boundary
+// is an episode boundary, as in a resumed run), a report after every update, and the progress bar
+// and progress.csv cells the runs print.
 #pragma once
 
 #include <functional>

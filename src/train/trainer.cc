@@ -522,6 +522,7 @@ std::unique_ptr<Learner> fresh_learner(Run& run) {
 void make_learner(Run& run) {
   const TrainOptions& options = run.options;
   run.learner = fresh_learner(run);
+  if (!options.resume && !options.load_model.empty()) run.learner->load(options.load_model);
   // SPDL values its tasks with the student's value function.
   if (run.curriculum)
     run.curriculum->teacher().set_value_estimator(learner_value_estimator(
@@ -688,8 +689,9 @@ void reset_learner(Run& run) {
 
 // The step checkpoint and latest.ckpt at the run's step.
 void save_step_checkpoint(Run& run) {
-  save_checkpoint(
-      run, {run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt"), run.latest});
+  const fs::path step = run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt");
+  save_checkpoint(run, {step, run.latest});
+  if (run.rank == 0 && run.options.on_checkpoint) run.options.on_checkpoint(step);
 }
 
 // The loop: a progress row (and the teacher's book) at every report, a checkpoint every
@@ -704,6 +706,8 @@ long train_loop(Run& run, TrainResult& result) {
   run.first_steps = run.steps();
   const long every = experiment ? experiment->evaluate_every() : options.checkpoint_every;
   const bool exact = experiment || options.reset_every > 0;
+  // Checkpoints inside the reports: one learn() call, no boundaries.
+  const bool in_reports = !options.checkpoints_split_learning && !exact;
   auto next_multiple = [&](long k) { return (run.steps() / k + 1) * k; };
   long next_checkpoint = next_multiple(every);
   long next_reset = options.reset_every > 0 ? next_multiple(options.reset_every)
@@ -762,6 +766,10 @@ long train_loop(Run& run, TrainResult& result) {
     if (run.rank == 0 && !run.csv) throw UserError("cannot write '" + run.csv_file.string() + "'");
     run.rows.push_back(std::move(row));
     if (options.on_report) options.on_report(s);
+    if (in_reports && s.steps >= next_checkpoint && s.steps < options.steps) {
+      save_step_checkpoint(run);
+      next_checkpoint = next_multiple(every);
+    }
 
     // Only BabyBench scores behaviour.
     bar.show(s.steps, elapsed,
@@ -788,7 +796,7 @@ long train_loop(Run& run, TrainResult& result) {
                    .stopping = stopping};
   if (exact)
     loop.next_boundary = [&](long) { return std::min(next_checkpoint, next_reset); };
-  else
+  else if (!in_reports)
     loop.boundary_every = every;
   const long boundary = run_loop([&run]() -> Learner& { return *run.learner; }, loop);
   // The experiment's last evaluation, at the end of the budget.
@@ -798,7 +806,7 @@ long train_loop(Run& run, TrainResult& result) {
   result.steps = run.steps();
   result.seconds = std::chrono::duration<double>(Clock::now() - run.start).count();
   result.steps_per_second = (result.steps - run.first_steps) / std::max(result.seconds, 1e-9);
-  return exact ? next_checkpoint : boundary;
+  return exact || in_reports ? next_checkpoint : boundary;
 }
 
 // The end: the final checkpoint and the teacher's state, the ranks' networks compared, then (rank
@@ -807,13 +815,13 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   const TrainOptions& options = run.options;
   result.checkpoint = run.checkpoints / "final.ckpt";
   std::vector<fs::path> files = {run.latest, result.checkpoint};
-  if (run.steps() >= next_checkpoint) {
-    files.push_back(run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt"));
-  }
+  const fs::path step = run.checkpoints / ("step_" + std::to_string(run.steps()) + ".ckpt");
+  if (run.steps() >= next_checkpoint) files.push_back(step);
   // The teacher's state closes its book before the checkpoint records the book's size (an
   // experiment's evaluations dumped it already).
   write_teacher_log(run, !options.experiment);
   save_checkpoint(run, files);
+  if (run.rank == 0 && options.on_checkpoint && files.back() == step) options.on_checkpoint(step);
   VecEnv& vec = *run.training.vec;
   for (int i = 0; i < vec.num_envs(); ++i) vec.env(i).close();
   result.parameter_hash = run.learner->parameter_hash();
@@ -891,6 +899,21 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   const long next_checkpoint = train_loop(run, result);
   finish(run, next_checkpoint, result);
   return result;
+}
+
+CheckpointLearner load_learner(const std::filesystem::path& checkpoint, const std::string& env_id,
+                               const envs::EnvOptions& options,
+                               const std::map<std::string, std::string>& overrides,
+                               std::uint64_t seed) {
+  const CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
+  std::map<std::string, std::string> hyperparameters = parse_hyperparameter_text(info.config);
+  for (const auto& [name, value] : overrides) hyperparameters[name] = value;
+  CheckpointLearner out;
+  out.vec = make_env_training(env_id, 1, 1, seed, nullptr, 0, options).vec;
+  out.learner = learn::make_learner(info.algorithm, *out.vec,
+                                    {.seed = seed, .hyperparameters = hyperparameters});
+  out.learner->load(checkpoint);
+  return out;
 }
 
 train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,

@@ -107,6 +107,17 @@ struct TrainOptions {
   envs::EnvOptions env_options;
   // Keys written into a fresh run's run.json beside the run's own (e.g. a front end's arguments).
   nlohmann::ordered_json run_json = nlohmann::ordered_json::object();
+  // A fresh run's learner starts from this checkpoint's networks and step count (not its run:
+  // `cradle illustrate --load_model`); the hyperparameters are the caller's.
+  std::string load_model;
+  // false: the checkpoints are written from the progress report at or past each multiple of
+  // checkpoint_every, inside one learn() call, so that episodes run on across them as in a run
+  // without checkpoints (`cradle illustrate`, as the reference's callback saves); a resume then
+  // starts fresh episodes. true: learning stops at each checkpoint (an episode boundary).
+  bool checkpoints_split_learning = true;
+  // Called after each step checkpoint with its file (e.g. to name it as a front end's users
+  // expect); rank 0 only.
+  std::function<void(const std::filesystem::path& checkpoint)> on_checkpoint;
 };
 
 struct TrainResult {
@@ -132,6 +143,18 @@ std::optional<Config> babybench_config(const std::string& name);
 
 // With options.env set, only config.save_dir is read.
 TrainResult train(const Config& config, const TrainOptions& options);
+
+// A checkpoint's learner on a one-env vector of an env id (kept with it, the learner acts on it),
+// e.g. to test a trained policy on an env of its own: the checkpoint's hyperparameters with
+// `overrides` over them, seeded `seed` (a checkpoint that restores its generator overrides it).
+struct CheckpointLearner {
+  std::shared_ptr<learn::VecEnv> vec;
+  std::shared_ptr<learn::Learner> learner;
+};
+CheckpointLearner load_learner(const std::filesystem::path& checkpoint, const std::string& env_id,
+                               const envs::EnvOptions& options = {},
+                               const std::map<std::string, std::string>& overrides = {},
+                               std::uint64_t seed = 0);
 
 // The policy of a checkpoint, for `cradle evaluate --policy`: the mean action, or with `sampled`
 // actions drawn from the policy's distribution (as SB3's predict() does by default) by the

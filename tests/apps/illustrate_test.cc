@@ -62,6 +62,9 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   EXPECT_TRUE(fs::exists(models / "model_2.ckpt"));
   EXPECT_FALSE(fs::exists(models / "model_3.ckpt"));
   EXPECT_TRUE(fs::exists(models / "progress.csv"));
+  // The models are the run's step checkpoints under the reference's names (train::train's run).
+  EXPECT_TRUE(fs::equivalent(models / "model_1.ckpt", models / "checkpoints" / "step_32.ckpt"));
+  EXPECT_TRUE(fs::equivalent(models / "model_2.ckpt", models / "checkpoints" / "step_64.ckpt"));
   // Curves are drawn even when no training episode ended yet (reach lasts 1000 steps).
   EXPECT_GT(fs::file_size(models / "learning_curve_return.png"), 0u);
   EXPECT_GT(fs::file_size(models / "learning_curve_success.png"), 0u);
@@ -100,6 +103,10 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   EXPECT_EQ(model(), before);
   r = cradle_in(dir, again + " --overwrite");
   ASSERT_EQ(r.status, 0) << r.out;
+  // Retraining the folder's own model over it: the model is read before the folder is cleared.
+  r = cradle_in(dir, again + " --overwrite --load_model " + (models / "model_1.ckpt").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("trained 32 steps"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(models / "model_1.ckpt"));
   EXPECT_FALSE(fs::exists(models / "model_2.ckpt"));  // the earlier run's models went
   fs::remove_all(dir);
@@ -116,7 +123,7 @@ TEST(Illustrate, CatchCurriculumBooksEveryTrainingEpisode) {
                                 "--task-space " +
                                     file);
   ASSERT_EQ(r.status, 0) << r.out;
-  std::ifstream book(dir / "models" / "catch" / "cur" / "teacher.jsonl");
+  std::ifstream book(dir / "models" / "catch" / "cur" / "logs" / "teacher.jsonl");
   int train = 0, dumps = 0;
   for (std::string line; std::getline(book, line);) {
     const nlohmann::json j = nlohmann::json::parse(line);
