@@ -42,7 +42,7 @@
 #include "learn/meta/methods.h"
 #include "learn/registry.h"
 #include "train/babybench_vector.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 extern char** environ;
 

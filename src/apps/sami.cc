@@ -33,7 +33,7 @@
 #include "sami/scene.h"
 #include "sami/task.h"
 #include "sami/throughput.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 namespace cradle::apps {
 namespace {

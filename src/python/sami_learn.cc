@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "python/common.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 namespace cradle::python {
 

@@ -32,7 +32,7 @@
 #include "train/curriculum_env.h"
 #include "train/env_vector.h"
 #include "train/loop.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 #include "train/task_space.h"
 
 namespace cradle::train {

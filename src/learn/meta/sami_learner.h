@@ -30,7 +30,7 @@
 // the learner's seed, rng with seed ^ 0x5a4d49); the learning curves of both rules are compared in
 // docs/fidelity.md. The envs' reset seeds come from the learner's own generator (seeded with the
 // seed), which draws nothing else. `cradle sami train` runs these learners through `cradle
-// train`'s path (train/sami/sami_train.h).
+// train`'s path (train/sami/sami_experiment.h).
 //
 // Settings: SamiConfig (context_sac.h; defaults SaMI's MuJoCo ones, Panda's buffer_size,
 // batch_size and contrast_batch_size of 1000, 256, 256 come as hyperparameters) plus:

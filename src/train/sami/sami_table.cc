@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "train/run_json.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 namespace cradle::train {
 namespace {

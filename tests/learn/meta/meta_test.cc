@@ -15,7 +15,7 @@
 #include "learn/meta/samplers.h"
 #include "learn/meta/sance.h"
 #include "learn/meta/trajectory_replay.h"
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 namespace cradle::learn::meta {
 namespace {

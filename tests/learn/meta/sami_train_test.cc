@@ -1,7 +1,7 @@
 // SaMI's train / evaluate / table: a few-hundred-step run of every method on Panda push and on a
 // crippled locomotion env, the same run as `cradle train`'s, resume, evaluation files and the
 // table.
-#include "train/sami/sami_train.h"
+#include "train/sami/sami_experiment.h"
 
 #include <gtest/gtest.h>
 

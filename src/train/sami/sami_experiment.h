@@ -1,13 +1,17 @@
-// SaMI training, evaluation and tables (tma_sami.md §6-§8): `cradle sami train / evaluate / table`
-// and cradle.sami.train / evaluate in Python.
+// SaMI's experiment (tma_sami.md §6-§8): what the family brings to the one run and its own
+// evaluation and tables, for `cradle sami train / evaluate / table` and cradle.sami in Python.
+//   sami_experiment.cc  its facts (training task sets, the learners' presets), its run file and
+//                       `sami train`, a front end over `cradle train` (train/trainer.h)
+//   sami_evaluate.cc    `sami evaluate`: every task set of a split through the one rollout
+//   sami_table.cc       the paper's tables and Welch's t-test
 //
-// `sami train` is `cradle train` (train/trainer.h) with SaMI's flags: the env's training task sets
-// one per env (sami/<Env>:train), the method's learner (learn/meta/sami_learner.h: SaCCM is
-// "saccm"), no intrinsic reward, and SaMI's budget, horizon and batch sizes. Its folder is a
-// `cradle train` run's: run.json, logs/progress.csv and checkpoints/{step_<n>,latest,final}.ckpt
-// (every checkpoint_every env steps per env and at the end); `sami evaluate` adds
-// eval_<split>.json / .csv and contexts_<split>.csv. `cradle train --env sami/<Env> --algo saccm`
-// makes the same folder, which `sami evaluate` reads too.
+// `sami train` is `cradle train` with SaMI's flags: the env's training task sets one per env
+// (sami/<Env>:train), the method's learner (learn/meta/sami_learner.h: SaCCM is "saccm"), no
+// intrinsic reward, and SaMI's budget, horizon and batch sizes. Its folder is a `cradle train`
+// run's: run.json, logs/progress.csv and checkpoints/{step_<n>,latest,final}.ckpt (every
+// checkpoint_every env steps per env and at the end); `sami evaluate` adds eval_<split>.json /
+// .csv and contexts_<split>.csv. `cradle train --env sami/<Env> --algo saccm` makes the same
+// folder, which `sami evaluate` reads too.
 #pragma once
 
 #include <atomic>
