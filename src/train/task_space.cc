@@ -10,9 +10,8 @@
 #include "core/error.h"
 #include "core/jsonl.h"
 #include "teach/registry.h"
-#include "tma/tma_env.h"
+#include "train/families.h"
 #include "train/run_json.h"
-#include "train/tma_student.h"
 
 namespace cradle::train {
 namespace {
@@ -121,24 +120,7 @@ CurriculumSpec env_curriculum(const envs::EnvSpec& env) {
                     " has no task parameters for a teacher to set (`cradle envs` lists each "
                     "env's); give --task-space FILE.yml");
   }
-  CurriculumSpec spec;
-  // TeachMyAgent's benchmark facts are its student runs' (train/tma_student.h).
-  if (env.family == "tma") {
-    const envs::EnvIdParts id = envs::split_env_id(env.id);
-    const StudentEnv student =
-        tma_student_env({.env = tma::parse_env_id(id.name), .body = id.variant});
-    spec.space = student.space;
-    spec.reward_lb = student.reward_lb;
-    spec.reward_ub = student.reward_ub;
-    spec.initial_dist = student.initial_dist;
-    spec.expert_knowledge = "high";
-    return spec;
-  }
-  nlohmann::ordered_json bounds = nlohmann::ordered_json::object();
-  for (const envs::TaskParameter& p : env.parameters) bounds[p.name] = {p.low, p.high};
-  spec.space = teach::TaskSpace::from_json(bounds);
-  spec.env_options.use_score = env.family == "babybench";
-  return spec;
+  return family(env.family).curriculum(env);
 }
 
 std::shared_ptr<teach::TeacherController> make_controller(const CurriculumSpec& spec,

@@ -57,11 +57,11 @@ CurriculumSpec load_task_space(const std::filesystem::path& file, bool need_teac
 
 // The curriculum of `cradle train --env ID --teacher T` without a task-space file: every task
 // parameter the env declares (envs/registry.h; `cradle envs`), in its declared range, with its
-// family's facts. TeachMyAgent: the benchmark's (return bounds [-150, 350], Parkour 360, Stump
-// Tracks' easy corner, expert knowledge high, as `cradle tma run`); BabyBench: the teacher hears
-// the behaviour score (the env's reward is 0); MIMo and SaMI: the return, success by the env's
-// is_success flag. The teacher's name is left to the run. UserError for an env without task
-// parameters.
+// family's facts (train/families.h). TeachMyAgent: the benchmark's (return bounds [-150, 350],
+// Parkour 360, Stump Tracks' easy corner, expert knowledge high, as `cradle tma run`); BabyBench:
+// the teacher hears the behaviour score (the env's reward is 0); MIMo and SaMI: the return,
+// success by the env's is_success flag. The teacher's name is left to the run. UserError for an
+// env without task parameters.
 CurriculumSpec env_curriculum(const envs::EnvSpec& env);
 
 // A teacher of the caller's own (e.g. a Python object's, src/python/python_teacher.h) for a task

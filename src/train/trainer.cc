@@ -31,8 +31,8 @@
 #include "train/babybench_vector.h"
 #include "train/curriculum_env.h"
 #include "train/env_vector.h"
+#include "train/families.h"
 #include "train/loop.h"
-#include "train/sami/sami_experiment.h"
 #include "train/task_space.h"
 
 namespace cradle::train {
@@ -265,8 +265,10 @@ void check_options(Run& run) {
   // learners: whole episodes as trajectories, Panda's batch sizes).
   if (run.by_id && !options.resume) {
     const envs::EnvSpec spec = envs::env_spec(run.env_id);
-    for (const auto& [name, value] : sami_presets(spec.id, spec.max_episode_steps, run.algorithm))
-      run.hyperparameters.try_emplace(name, value);
+    if (const auto presets = family(spec.family).presets) {
+      for (const auto& [name, value] : presets(spec, run.algorithm))
+        run.hyperparameters.try_emplace(name, value);
+    }
   }
   if (options.resume) {
     const CheckpointInfo info = read_checkpoint_info(run.latest);

@@ -63,7 +63,7 @@ struct TrainOptions {
   bool randomize_start = false;  // random start postures within joint limits
   long checkpoint_every = 100000;
   // Overrides, by name, over the learner's defaults and what the env's family trains it with
-  // (train/sami/sami_experiment.h's sami_presets: SaMI's learners on an env by id).
+  // (train/families.h: SaMI's learners on an env by id).
   std::map<std::string, std::string> hyperparameters;
   int eval_episodes = 2;  // 0: no final evaluation
   int eval_duration = 1000;

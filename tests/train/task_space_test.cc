@@ -14,6 +14,7 @@
 #include "envs/babybench.h"
 #include "envs/mimo/sample_env.h"
 #include "fixture.h"
+#include "train/families.h"
 #include "train/trainer.h"
 
 namespace cradle::train {
@@ -113,6 +114,31 @@ TEST(EnvCurriculum, EveryDeclaredParameterWithTheFamilysFacts) {
     FAIL() << "mimo/standup has no task parameters";
   } catch (const UserError& e) {
     EXPECT_NE(std::string(e.what()).find("mimo/standup has no task parameters"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Every family of the env registry has its entry (the run asks it for every env id), each with a
+// curriculum, and only SaMI's presets: its learners store whole episodes (horizon = the episode).
+TEST(Families, EveryRegisteredFamilyHasItsFacts) {
+  for (const envs::EnvSpec& spec : envs::env_specs()) {
+    const Family& f = family(spec.family);
+    EXPECT_NE(f.curriculum, nullptr) << spec.id;
+    EXPECT_EQ(f.presets != nullptr, spec.family == "sami") << spec.id;
+    if (!spec.parameters.empty()) {
+      EXPECT_TRUE(env_curriculum(spec).space) << spec.id;
+    }
+  }
+  const envs::EnvSpec panda = envs::env_spec("sami/PandaPush:train");
+  const auto presets = family("sami").presets(panda, "saccm");
+  EXPECT_EQ(presets.at("horizon"), std::to_string(panda.max_episode_steps));
+  EXPECT_EQ(presets.at("batch_size"), "256");
+  EXPECT_TRUE(family("sami").presets(panda, "sac").empty());  // not one of SaMI's learners
+  try {
+    (void)family("atari");
+    FAIL() << "atari is no family";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("(babybench, mimo, tma, sami)"), std::string::npos)
         << e.what();
   }
 }
