@@ -333,9 +333,9 @@ void register_tma(CLI::App& app) {
         r.gradient_steps_per_s, 100 * r.teacher_s / std::max(r.wall_s, 1e-9), r.last_pct_mastered);
     if (r.stopped) {
       std::printf(
-          "stopped by a signal at %ld env steps; --resume continues from the checkpoint at %ld env "
-          "steps (the last evaluation): cradle tma run ... --out %s --resume\n",
-          r.env_steps, r.checkpoint_steps, out.string().c_str());
+          "stopped by a signal at %ld env steps; --resume continues from its checkpoint there: "
+          "cradle tma run ... --out %s --resume\n",
+          r.checkpoint_steps, out.string().c_str());
       throw Stopped{};  // exit 130: `tma campaign` must not count the seed as finished
     }
   });
