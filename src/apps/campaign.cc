@@ -5,9 +5,10 @@
 // or a local process pool; the analysis of each kind's results tree is campaign_analyze.cc.
 //
 // A seed is finished when its folder holds `finished` (written by the launcher after exit status
-// 0) or what its command leaves when done: done.json (`tma run`); checkpoints/final.ckpt at the
-// run's whole budget and every asked evaluation (`sami train`); checkpoints/final.ckpt at the
-// asked steps, with evaluation.json when the run evaluates (`train`).
+// 0) or what its command leaves when done: summary.json of a run not stopped (`tma run`);
+// checkpoints/final.ckpt at the run's whole budget and every asked evaluation (`sami train`);
+// checkpoints/final.ckpt at the asked steps, with evaluation.json when the run evaluates
+// (`train`).
 #include "apps/campaign.h"
 
 #include <fcntl.h>
@@ -413,8 +414,14 @@ bool final_checkpoint_holds(const fs::path& dir, long steps) {
 std::string done_by_files(const SeedRun& r) {
   std::error_code ec;
   switch (r.line->kind) {
-    case RunKind::kTma:
-      return fs::exists(r.dir / "done.json", ec) ? "done.json" : "";
+    case RunKind::kTma: {
+      // summary.json of a run that was not stopped: its whole budget trained and evaluated.
+      std::ifstream in(r.dir / "summary.json");
+      const nlohmann::json summary = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+      const bool done =
+          summary.is_object() && summary.contains("stopped") && summary["stopped"] == false;
+      return done ? "summary.json" : "";
+    }
     case RunKind::kSami: {
       // The whole budget in checkpoints/final.ckpt, then every evaluation.
       long budget = 0;
@@ -439,8 +446,7 @@ std::string done_by_files(const SeedRun& r) {
 
 bool finished(const SeedRun& r) {
   std::error_code ec;
-  return fs::exists(r.dir / "done.json", ec) || fs::exists(r.dir / "finished", ec) ||
-         !done_by_files(r).empty();
+  return fs::exists(r.dir / "finished", ec) || !done_by_files(r).empty();
 }
 
 bool on_path(const std::string& program) {
@@ -529,9 +535,8 @@ void write_launch_json(const LaunchOptions& o, const SeedRun& r, const std::stri
   write_text(r.dir / "launch.json", j.dump(1) + "\n");
 }
 
-// The finished marker (when the run wrote no done.json of its own).
+// The finished marker.
 void mark_finished(const fs::path& dir, double wall_s) {
-  if (fs::exists(dir / "done.json")) return;
   write_text(dir / "finished",
              nlohmann::json{{"exit_status", 0}, {"wall_s", wall_s}}.dump() + "\n");
 }
@@ -648,7 +653,7 @@ std::string sbatch_script(const LaunchOptions& o, const Line& line, const std::s
     << "slot=0\n"
     << "for seed in $(seq $first $last); do\n"
     << "  dir=" << quote(seed_dir) << "$seed\n"
-    << "  [ -e \"$dir/done.json\" ] || [ -e \"$dir/finished\" ] && continue\n"
+    << "  [ -e \"$dir/finished\" ] && continue\n"
     << "  mkdir -p \"$dir\"\n"
     << bash_continue_flag(line.kind) << "  cpu=${cpus[$((slot % ${#cpus[@]}))]}\n"
     << "  slot=$((slot + 1))\n"
@@ -660,7 +665,7 @@ std::string sbatch_script(const LaunchOptions& o, const Line& line, const std::s
     s << "    taskset -c \"$cpu\" " << quote(self_exe()) << " sami evaluate --run \"$dir\" --split "
       << split << " --episodes " << line.eval_episodes << " >> \"$dir/log.txt\" 2>&1 || exit $?\n";
   }
-  s << "    [ -e \"$dir/done.json\" ] || echo \"{\\\"exit_status\\\": 0, \\\"wall_s\\\": "
+  s << "    echo \"{\\\"exit_status\\\": 0, \\\"wall_s\\\": "
        "$(($(date +%s) - start))}\" > \"$dir/finished\"\n"
     << "  ) &\n"
     << "  pids+=($!)\n"
@@ -963,7 +968,7 @@ int launch(const LaunchOptions& o) {
     // tests the markers only) skips it too.
     for (const SeedRun& r : skipped_runs) {
       std::error_code ec;
-      if (!fs::exists(r.dir / "finished", ec) && !fs::exists(r.dir / "done.json", ec)) {
+      if (!fs::exists(r.dir / "finished", ec)) {
         write_text(
             r.dir / "finished",
             nlohmann::json{{"exit_status", 0}, {"detected_from", done_by_files(r)}}.dump() + "\n");

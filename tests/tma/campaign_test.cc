@@ -421,6 +421,26 @@ TEST(TmaCampaign, RealRunsOfGeneratedLinesAreAnalysed) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["arguments"]["seed"], 1);
   EXPECT_EQ(j["arguments"]["max_stump_h"], 9.0);
+  // --resume: a seed whose marker is gone is finished by its summary.json (the run not stopped);
+  // one whose run was stopped runs on.
+  fs::remove(run / "finished");
+  const fs::path other = results / "Random_criterion_1_allow_expert_knowledge_none" /
+                         "Random_criterion_1_allow_expert_knowledge_none_s0";
+  fs::remove(other / "finished");
+  std::string summary;
+  {
+    std::ifstream in(other / "summary.json");
+    summary.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_NE(summary.find("\"stopped\": false"), std::string::npos) << summary;
+  summary.replace(summary.find("\"stopped\": false"), 17, "\"stopped\": true");
+  std::ofstream(other / "summary.json", std::ios::trunc) << summary;
+  r = run_cradle("tma campaign launch " + (dir / "c.txt").string() +
+                 " --local --resume --results " + results.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("--resume: 3 finished seeds skipped"), std::string::npos) << r.out;
+  EXPECT_NE(cradle::test::read_lines(run / "finished").front().find("summary.json"),
+            std::string::npos);
   r = run_cradle("tma analyze " + results.string());
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("4 runs, baseline Random"), std::string::npos) << r.out;
