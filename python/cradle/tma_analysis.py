@@ -8,7 +8,7 @@
 
 RESULTS is the tree of ``cradle tma campaign launch`` (docs/tma_campaigns.md): run folders holding
 ``progress.csv`` (one row per evaluation), ``test_returns.csv``, ``test_set.csv``, ``run.json``,
-``teacher.jsonl`` and the launcher's ``launch.json`` (campaign, experiment, seed, arguments).
+``logs/teacher.jsonl`` and the launcher's ``launch.json`` (campaign, experiment, seed, arguments).
 A run is labelled by its campaign (one teacher and its parameters); the baseline is the campaign
 whose teacher is Random unless ``--baseline`` names another. Needs only numpy, scipy, pandas and
 matplotlib (Debian's), so it also runs as a plain script without the compiled extension.
