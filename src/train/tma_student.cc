@@ -518,7 +518,8 @@ TmaRun run_tma(const TmaRunArguments& a) {
   config.save_dir = out.string();
   const TrainResult trained = train(config, train_options);
   StudentRunResult result = evaluations->result();
-  result.stopped = result.stopped && trained.steps < total_steps;
+  // Ended before its budget: stopped (a signal to any rank of a data-parallel run stops them all).
+  result.stopped = trained.steps < total_steps;
   return {.out = out, .result = result, .parameter_hash = trained.parameter_hash};
 }
 
