@@ -112,6 +112,9 @@ void register_train(CLI::App& app) {
   cmd->add_option("--checkpoint-every", opts->train.checkpoint_every,
                   "Env steps between checkpoints")
       ->check(CLI::Range(1L, 100000000000L));
+  cmd->add_option("--reset-every", opts->train.reset_every,
+                  "Env steps between fresh learners (networks, optimiser, buffer; 0: never)")
+      ->check(CLI::Range(0L, 100000000000L));
   cmd->add_option("--hp", opts->hp, "Hyperparameter override name=value (repeatable)");
   cmd->add_option("--task-space", opts->train.task_space,
                   "Curriculum: task-space YAML whose teacher sets the reset options");

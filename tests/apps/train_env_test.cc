@@ -174,6 +174,40 @@ TEST(TrainEnv, ATeacherAloneRunsTheFamilysCurriculum) {
   fs::remove_all(dir);
 }
 
+// --reset-every: a fresh learner every N env steps in any run, the run's step count going on; the
+// checkpoint records the resets, so a resumed run continues the second learner.
+TEST(TrainEnv, ResetEveryStartsFreshLearnersAndResumes) {
+  const fs::path dir = cradle::test::fresh_dir("train_env_reset");
+  const std::string args =
+      "train --env mimo/reach --algo ppo --envs 1 --reset-every 128 --checkpoint-every 64 "
+      "--intrinsic '' --eval-episodes 0 --hp n_steps=32 --hp batch_size=32 --hp pi_layers=8 "
+      "--hp vf_layers=8 --save-dir " +
+      (dir / "run").string();
+  RunResult r = run_cradle(args + " --steps 192");
+  ASSERT_EQ(r.status, 0) << r.out;
+  // One row per update, the run's steps going on across the reset at 128.
+  std::vector<std::string> progress = read_lines(dir / "run" / "logs" / "progress.csv");
+  ASSERT_EQ(progress.size(), 1u + 6);
+  for (size_t k = 1; k < progress.size(); ++k) EXPECT_EQ(first_cell(progress[k]), 32.0 * k);
+  std::ifstream in(dir / "run" / "checkpoints" / "final.ckpt", std::ios::binary);
+  const std::string ckpt{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_NE(ckpt.find("\"learner_resets\":1"), std::string::npos);
+  EXPECT_NE(ckpt.find("\"step_offset\":128"), std::string::npos);
+  EXPECT_NE(ckpt.find("\"steps\":64"), std::string::npos);  // the second learner's own
+  const nlohmann::json run = nlohmann::json::parse(std::ifstream(dir / "run" / "run.json"));
+  EXPECT_EQ(run["reset_every"], 128);
+  r = run_cradle(args + " --steps 320 --resume");
+  ASSERT_EQ(r.status, 0) << r.out;
+  progress = read_lines(dir / "run" / "logs" / "progress.csv");
+  ASSERT_EQ(progress.size(), 1u + 10);
+  EXPECT_EQ(first_cell(progress.back()), 320);
+  std::ifstream again(dir / "run" / "checkpoints" / "final.ckpt", std::ios::binary);
+  const std::string resumed{std::istreambuf_iterator<char>(again), {}};
+  EXPECT_NE(resumed.find("\"learner_resets\":2"), std::string::npos);
+  EXPECT_NE(resumed.find("\"step_offset\":256"), std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(TrainEnv, WrongCombinationsAreOneLineErrors) {
   const fs::path dir = cradle::test::fresh_dir("train_env_errors");
   const std::string config = cradle::test::config_path("config_selftouch.yml").string();
