@@ -86,6 +86,7 @@ def train(
     teacher=None,
     overwrite=False,
     procs=0,
+    reset_every=0,
 ):
     """Trains a policy with Cradle's C++ learners, exactly as `cradle train` does (same options,
     same outputs under save_dir: training log, logs/progress.csv, checkpoints/, plots/, the
@@ -120,6 +121,8 @@ def train(
       envs to finish (as --async-batch; 1 <= K < envs); 0: lock-step.
     procs: P > 0 runs the envs in P worker processes (as --procs; envs a multiple of P), each with
       its own GL contexts, so envs that render draw in parallel; the same run as with threads.
+    reset_every: N > 0 replaces the learner by a fresh one (networks, optimiser, buffer) every N
+      env steps, the run's step count going on (as --reset-every); 0: never.
 
     Returns a dict: run (the run folder), steps, seconds, steps_per_second, training_score,
     checkpoint, evaluation (the evaluation report, a dict) and random_evaluation. Ctrl-C stops training with a
@@ -135,6 +138,10 @@ def train(
     spec, terms = _split_intrinsic(intrinsic)
     if not isinstance(procs, numbers.Integral) or isinstance(procs, bool) or procs < 0:
         raise ValueError(f"procs must be a non-negative integer (0: threads), not {procs!r}")
+    if (not isinstance(reset_every, numbers.Integral) or isinstance(reset_every, bool)
+            or reset_every < 0):
+        raise ValueError(f"reset_every must be a non-negative integer (0: never), not "
+                         f"{reset_every!r}")
     hp = {str(k): str(v) for k, v in (hyperparameters or {}).items()}
     base = load_config(config) if config is not None else _cradle.default_config()
     result = _cradle.train(
@@ -145,6 +152,7 @@ def train(
         save_dir=os.fspath(save_dir) if save_dir is not None else "",
         task_space=os.fspath(task_space) if task_space is not None else "",
         teacher="" if teacher is None else teacher, overwrite=bool(overwrite), procs=int(procs),
+        reset_every=int(reset_every),
     )
     for key in ("evaluation", "random_evaluation"):
         if result[key] is not None:

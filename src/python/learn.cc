@@ -428,7 +428,8 @@ void bind_learn(py::module_& m) {
          const std::map<std::string, std::string>& hyperparameters, int eval_episodes,
          int eval_duration, bool eval_render, bool compare_random, bool progress_bar,
          const py::list& terms, const std::string& env, const std::string& save_dir,
-         const std::string& task_space, const py::object& teacher, bool overwrite, int procs) {
+         const std::string& task_space, const py::object& teacher, bool overwrite, int procs,
+         long reset_every) {
         // An env id of any family: a BabyBench id trains its config, the others by id (their
         // run folder: save_dir, else results/<id>).
         Config run_config = config;
@@ -470,6 +471,7 @@ void bind_learn(py::module_& m) {
         }
         o.overwrite = overwrite;
         o.procs = procs;
+        o.reset_every = reset_every;
         std::vector<PyTerm> py_terms;
         for (const py::handle t : terms) {
           const py::tuple tt = py::reinterpret_borrow<py::tuple>(t);
@@ -506,6 +508,7 @@ void bind_learn(py::module_& m) {
       py::arg("eval_render"), py::arg("compare_random"), py::arg("progress_bar"), py::arg("terms"),
       py::arg("env") = "", py::arg("save_dir") = "", py::arg("task_space") = "",
       py::arg("teacher") = "", py::arg("overwrite") = false, py::arg("procs") = 0,
+      py::arg("reset_every") = 0,
       "Trains with the C++ learners (see cradle.train). Python reward terms are (fn, weight, "
       "full) tuples; teacher is a teacher's name or a Python teacher object.");
 

@@ -86,6 +86,21 @@ def test_a_finished_run_is_refused_unless_resumed_or_overwritten(tmp_path):
     assert len(rows(run)) == 2
 
 
+def test_reset_every_starts_fresh_learners_as_the_cli_does(tmp_path):
+    run = tmp_path / "run"
+    result = cradle.train(env="mimo/reach", steps=256, envs=1, hyperparameters=PPO, save_dir=run,
+                          progress_bar=False, eval_episodes=0, reset_every=128,
+                          checkpoint_every=128)
+    assert result["steps"] == 256
+    assert [int(r["global_step"]) for r in rows(run)] == [64, 128, 192, 256]
+    assert json.loads((run / "run.json").read_text())["reset_every"] == 128
+    assert b'"learner_resets":1' in (run / "checkpoints" / "final.ckpt").read_bytes()
+    for bad in (-1, 1.5, True, "128"):
+        with pytest.raises(ValueError, match="reset_every"):
+            cradle.train(env="mimo/reach", save_dir=tmp_path / "bad", reset_every=bad)
+    assert not (tmp_path / "bad").exists()
+
+
 def test_wrong_arguments_are_value_errors(tmp_path):
     with pytest.raises(ValueError, match="config .* or env"):
         cradle.train()
