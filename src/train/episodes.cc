@@ -6,6 +6,8 @@
 #include <optional>
 #include <vector>
 
+#include "core/error.h"
+
 namespace cradle::train {
 
 namespace {
@@ -14,7 +16,7 @@ namespace {
 std::vector<EpisodeOutcome> play(
     envs::Env& env, const EpisodePolicy& policy, std::size_t count,
     const std::function<std::optional<std::uint64_t>(std::size_t)>& seed_of, int max_steps,
-    const EpisodeStepFn& on_step, const EpisodeStartFn& on_start) {
+    const EpisodeStepFn& on_step, const EpisodeStartFn& on_start, bool fixed_length) {
   std::vector<double> action(env.action_space().size());
   const int success = env.info().find("is_success");
   const int failure = env.info().find("is_failure");
@@ -32,7 +34,7 @@ std::vector<EpisodeOutcome> play(
       ++r.length;
       if (on_step) on_step(static_cast<int>(e), env, s);
       const bool capped = max_steps > 0 && r.length >= max_steps;
-      if (s.terminated || s.truncated || capped) {
+      if (((s.terminated || s.truncated) && !fixed_length) || capped) {
         r.truncated = !s.terminated;
         break;
       }
@@ -50,10 +52,11 @@ std::vector<EpisodeOutcome> play(
 std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
                                          std::span<const std::uint64_t> seeds, int max_steps,
                                          const EpisodeStepFn& on_step,
-                                         const EpisodeStartFn& on_start) {
+                                         const EpisodeStartFn& on_start, bool fixed_length) {
+  if (fixed_length && max_steps < 1) throw UserError("a fixed-length rollout needs max_steps >= 1");
   return play(
       env, policy, seeds.size(), [&](std::size_t e) { return std::optional(seeds[e]); }, max_steps,
-      on_step, on_start);
+      on_step, on_start, fixed_length);
 }
 
 std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy, int episodes,
@@ -61,7 +64,8 @@ std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& po
                                          const EpisodeStartFn& on_start) {
   return play(
       env, policy, static_cast<std::size_t>(std::max(episodes, 0)),
-      [](std::size_t) { return std::optional<std::uint64_t>(); }, max_steps, on_step, on_start);
+      [](std::size_t) { return std::optional<std::uint64_t>(); }, max_steps, on_step, on_start,
+      /*fixed_length=*/false);
 }
 
 nlohmann::ordered_json episodes_json(const std::vector<EpisodeOutcome>& episodes) {

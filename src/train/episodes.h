@@ -37,11 +37,14 @@ using EpisodeStepFn = std::function<void(int episode, const envs::Env&, const en
 using EpisodeStartFn = std::function<void(int episode, envs::Env&)>;
 
 // Plays one episode per seed on `env` (reset with that seed) until it terminates or truncates,
-// or after max_steps steps when max_steps > 0 (then counted as truncated).
+// or after max_steps steps when max_steps > 0 (then counted as truncated). With `fixed_length`,
+// every episode is exactly max_steps steps, whatever the env says (BabyBench's evaluation of a
+// duration, which runs on past the env's own episode length).
 std::vector<EpisodeOutcome> run_episodes(envs::Env& env, const EpisodePolicy& policy,
                                          std::span<const std::uint64_t> seeds, int max_steps = 0,
                                          const EpisodeStepFn& on_step = nullptr,
-                                         const EpisodeStartFn& on_start = nullptr);
+                                         const EpisodeStartFn& on_start = nullptr,
+                                         bool fixed_length = false);
 // The same for `episodes` episodes that go on with the env's own random stream (each reset
 // without a seed, the outcomes' seed 0): SaMI's evaluation, whose env draws every episode's task
 // from the stream of its one seed.

@@ -16,6 +16,7 @@
 #include "eval/figures.h"
 #include "eval/log_check.h"
 #include "eval/video.h"
+#include "train/episodes.h"
 #include "train/frames.h"
 
 namespace cradle::train {
@@ -187,32 +188,41 @@ EvaluationReport evaluate(const Config& config, const EvaluationOptions& options
 
   std::vector<double> action(env.action_space().size());
   std::vector<double> first_trace;
+  // Each episode through the one rollout, exactly `duration` steps (BabyBench runs on past the
+  // env's own episode length): after every step its trajectory row and its video frame.
+  Trajectory traj;
+  std::optional<eval::VideoWriter> video;
+  const EpisodePolicy episode_policy{
+      .act = [&](const envs::ObservationBuffers&, std::span<double> a) {
+        policy(env, a);
+        action.assign(a.begin(), a.end());  // the trajectory's row of this step
+      }};
+  const EpisodeStepFn on_step = [&](int, const envs::Env&, const envs::StepResult&) {
+    traj.qpos.insert(traj.qpos.end(), env.data()->qpos, env.data()->qpos + m->nq);
+    traj.actions.insert(traj.actions.end(), action.begin(), action.end());
+    traj.infos.push_back(env.info().to_json().dump());
+    if (panels.trace) {
+      env.task().trace(env.data(), trace_step);
+      traj.trace.insert(traj.trace.end(), trace_step.begin(), trace_step.end());
+    }
+    if (video) {
+      composer->compose(env, frame);
+      video->write(frame);
+    }
+  };
   for (int i = 0; i < options.episodes; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    env.reset(options.seed + static_cast<std::uint64_t>(i));
-    Trajectory traj;
+    traj = {};
     traj.qpos.reserve(static_cast<size_t>(options.duration) * m->nq);
-    std::optional<eval::VideoWriter> video;
     if (options.render) {
       video.emplace(dir / "videos" / ("episode_" + std::to_string(i) + options.video_extension),
                     FrameComposer::kWidth, FrameComposer::kHeight, fps);
     }
-    for (int t = 0; t < options.duration; ++t) {
-      policy(env, action);
-      env.step(action);
-      traj.qpos.insert(traj.qpos.end(), env.data()->qpos, env.data()->qpos + m->nq);
-      traj.actions.insert(traj.actions.end(), action.begin(), action.end());
-      traj.infos.push_back(env.info().to_json().dump());
-      if (panels.trace) {
-        env.task().trace(env.data(), trace_step);
-        traj.trace.insert(traj.trace.end(), trace_step.begin(), trace_step.end());
-      }
-      if (video) {
-        composer->compose(env, frame);
-        video->write(frame);
-      }
-    }
+    const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(i);
+    run_episodes(env, episode_policy, std::span(&seed, 1), options.duration, on_step, nullptr,
+                 /*fixed_length=*/true);
     if (video) video->close();
+    video.reset();
     write_trajectory(traj, options.duration, m->nq, static_cast<int>(action.size()), panels,
                      dir / "trajectories" / ("episode_" + std::to_string(i) + ".npz"));
     if (i == 0) first_trace = traj.trace;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/error.h"
 #include "envs/registry.h"
 
 namespace cradle::train {
@@ -61,6 +62,39 @@ TEST(RunEpisodes, StopsAtMaxStepsAsTruncated) {
     EXPECT_FALSE(r.success);
   }
   EXPECT_EQ(episodes_json(results)["success_rate"], 0.0);
+}
+
+// A fixed length runs on past the env's own end (BabyBench's evaluation of a duration): the
+// episode is exactly max_steps steps; without it the same episode stops where the env ends it.
+TEST(RunEpisodes, AFixedLengthRunsOnPastTheEnvsEnd) {
+  auto env = envs::make_env("mimo/standup", 0);  // truncates at 500 steps
+  const std::vector<std::uint64_t> seeds = {5};
+  EXPECT_EQ(run_episodes(*env, constant(0.0), seeds, 600)[0].length, 500);
+  int steps = 0;
+  const auto fixed = run_episodes(
+      *env, constant(0.0), seeds, 600,
+      [&](int, const envs::Env&, const envs::StepResult&) { ++steps; }, nullptr,
+      /*fixed_length=*/true);
+  EXPECT_EQ(fixed[0].length, 600);
+  EXPECT_EQ(steps, 600);
+  EXPECT_THROW(run_episodes(*env, constant(0.0), seeds, 0, nullptr, nullptr, true), UserError);
+}
+
+// Episodes without seeds go on with the env's own stream: after a seeded reset they repeat what a
+// second run from the same seed plays, and differ from one another.
+TEST(RunEpisodes, UnseededEpisodesGoOnWithTheEnvsStream) {
+  auto play = [] {
+    auto env = envs::make_env("tma/stump-tracks:old_classic_bipedal", 0);
+    env->reset(7);
+    return run_episodes(*env, constant(0.3), 2);
+  };
+  const auto a = play(), b = play();
+  ASSERT_EQ(a.size(), 2u);
+  for (int e = 0; e < 2; ++e) {
+    EXPECT_EQ(a[e].episode_return, b[e].episode_return);
+    EXPECT_EQ(a[e].seed, 0u);
+  }
+  EXPECT_NE(a[0].episode_return, a[1].episode_return);
 }
 
 }  // namespace
