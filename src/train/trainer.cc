@@ -250,6 +250,13 @@ void check_options(Run& run) {
       throw UserError(
           "--randomize-start and --compare-random are for BabyBench configs, not --env");
   }
+  // Checkpoints inside the reports keep episodes running across them; a BabyBench checkpoint ends
+  // every env's episode in the training log, so a config's run checkpoints at boundaries.
+  if (!options.checkpoints_split_learning && !run.by_id) {
+    throw UserError(
+        "checkpoints inside the reports are for runs by env id (a BabyBench checkpoint ends the "
+        "training log's episodes)");
+  }
   run.dir = run.config.save_dir;
   run.checkpoints = run.dir / "checkpoints";
   run.latest = run.checkpoints / "latest.ckpt";

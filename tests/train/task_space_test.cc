@@ -143,6 +143,24 @@ TEST(Families, EveryRegisteredFamilyHasItsFacts) {
   }
 }
 
+// Checkpoints written inside the reports (`cradle illustrate`'s) are for runs by id: a BabyBench
+// config's checkpoint ends its training log's episodes, so its run is refused before anything is
+// written.
+TEST(TrainOptionsCheck, CheckpointsInsideReportsAreForRunsById) {
+  const std::filesystem::path dir = test::fresh_dir("checkpoints_in_reports");
+  Config config = test::reference_config("config_selftouch.yml");
+  config.save_dir = (dir / "run").string();
+  TrainOptions o{.steps = 64, .envs = 1, .eval_episodes = 0, .progress_bar = false};
+  o.checkpoints_split_learning = false;
+  try {
+    train(config, o);
+    FAIL() << "a BabyBench run with checkpoints inside the reports";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("for runs by env id"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "run"));
+}
+
 TEST(TaskSpaceFile, ShippedBabyBenchExampleLoads) {
   const CurriculumSpec spec = load_task_space(std::filesystem::path(CRADLE_SOURCE_DIR) /
                                               "configs/curricula/babybench_posture.yml");
