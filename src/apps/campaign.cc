@@ -36,6 +36,7 @@
 #include "apps/commands.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/text.h"
 #include "envs/registry.h"
 #include "learn/checkpoint.h"
 #include "learn/intrinsic/reward.h"
@@ -860,20 +861,8 @@ bool has_control(const std::string& s) {
   });
 }
 
-std::string shown(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (out.size() >= 60) return out + "...";
-    if (std::iscntrl(static_cast<unsigned char>(c))) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", static_cast<unsigned char>(c));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
+// A campaign value in an error: printable, at most 60 characters.
+std::string shown(const std::string& s) { return printable(s, 60); }
 
 std::string number(double v) {
   std::ostringstream s;

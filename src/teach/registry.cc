@@ -3,14 +3,13 @@
 #include "teach/registry.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <set>
 #include <string>
 #include <variant>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace cradle::teach {
 namespace {
@@ -274,27 +273,15 @@ std::string joined_names() {
 }  // namespace
 
 nlohmann::json parse_teacher_params(const std::vector<std::string>& flags) {
-  const auto shown = [](const std::string& text) {
-    std::string out;
-    for (const char c : text) {
-      if (std::iscntrl(static_cast<unsigned char>(c))) {
-        char code[8];
-        std::snprintf(code, sizeof code, "\\x%02x", static_cast<unsigned char>(c));
-        out += code;
-      } else {
-        out += c;
-      }
-    }
-    return out;
-  };
   nlohmann::json params = nlohmann::json::object();
   for (const std::string& flag : flags) {
     const size_t eq = flag.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw UserError("--teacher-param '" + shown(flag) + "' (expected key=value)");
+      throw UserError("--teacher-param '" + printable(flag) + "' (expected key=value)");
     const std::string key = flag.substr(0, eq), value = flag.substr(eq + 1);
     if (params.contains(key))
-      throw UserError("--teacher-param " + shown(key) + " is given twice (expected each key once)");
+      throw UserError("--teacher-param " + printable(key) +
+                      " is given twice (expected each key once)");
     params[key] =
         nlohmann::json::accept(value) ? nlohmann::json::parse(value) : nlohmann::json(value);
   }
