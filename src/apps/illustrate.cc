@@ -258,12 +258,7 @@ void run(const IllustrateOptions& o) {
     // Each saved checkpoint is also model_<k>.ckpt, the reference's name (a hard link).
     long saved_at = first;
     auto name_model = [&](const fs::path& checkpoint, long steps) {
-      const fs::path model = dir / ("model_" + std::to_string(++saved) + ".ckpt");
-      std::error_code link_ec;
-      fs::remove(model, link_ec);
-      fs::create_hard_link(checkpoint, model, link_ec);
-      if (link_ec) fs::copy_file(checkpoint, model, fs::copy_options::overwrite_existing, link_ec);
-      if (link_ec) throw UserError("cannot write '" + model.string() + "': " + link_ec.message());
+      link_file(checkpoint, dir / ("model_" + std::to_string(++saved) + ".ckpt"));
       saved_at = steps;
     };
     to.on_checkpoint = [&](const fs::path& checkpoint) {

@@ -20,4 +20,17 @@ inline void make_folder(const std::filesystem::path& folder, const std::string& 
   }
 }
 
+// `to` becomes the same file as `from` (a hard link, or a copy where links fail), replacing what
+// stood there in one rename; a UserError "cannot write '<to>': <reason>" when that fails.
+inline void link_file(const std::filesystem::path& from, const std::filesystem::path& to) {
+  const std::filesystem::path tmp = to.string() + ".tmp";
+  std::error_code ec;
+  std::filesystem::remove(tmp, ec);
+  std::filesystem::create_hard_link(from, tmp, ec);
+  if (ec)
+    std::filesystem::copy_file(from, tmp, std::filesystem::copy_options::overwrite_existing, ec);
+  if (!ec) std::filesystem::rename(tmp, to, ec);
+  if (ec) throw UserError("cannot write '" + to.string() + "': " + ec.message());
+}
+
 }  // namespace cradle

@@ -637,15 +637,7 @@ void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
   }
   // One write; the other names are the same file (hard links, or copies where links fail).
   save_run_checkpoint(files.front(), *run.learner, run.reward.get(), state);
-  for (size_t k = 1; k < files.size(); ++k) {
-    const fs::path tmp = files[k].string() + ".tmp";
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    fs::create_hard_link(files.front(), tmp, ec);
-    if (ec) fs::copy_file(files.front(), tmp, fs::copy_options::overwrite_existing, ec);
-    if (!ec) fs::rename(tmp, files[k], ec);
-    if (ec) throw UserError("cannot write '" + files[k].string() + "': " + ec.message());
-  }
+  for (size_t k = 1; k < files.size(); ++k) link_file(files.front(), files[k]);
   // The newest step checkpoint alone, when the run keeps only that.
   const std::string newest = "step_" + std::to_string(run.steps()) + ".ckpt";
   const bool wrote_step = std::any_of(files.begin(), files.end(),
