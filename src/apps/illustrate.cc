@@ -3,7 +3,8 @@
 // [--use_muscles] [--render_video] [--stochastic] [--envs K] [--seed S] [--hp name=value]
 // [--task-space FILE.yml [--teacher T]]`: the
 // reference's illustrations.py. Trains a policy on a MIMo sample env (checkpoints
-// models/<env>/<name>/model_<k>.ckpt every save_every steps, progress.csv, learning-curve PNGs),
+// models/<env>/<name>/model_<k>.ckpt every save_every steps; the run's logs/progress.csv with the
+// training success rate, and plots/ with its learning curves),
 // then runs test_for steps with it (or with random actions when there is no model), optionally
 // filming each episode, and prints the success rate and the mean return per episode. Without
 // --algorithm the algorithm is the --load_model checkpoint's; without either, testing takes
@@ -13,10 +14,8 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
@@ -29,7 +28,6 @@
 #include "core/rng.h"
 #include "envs/mimo/sample_env.h"
 #include "envs/registry.h"
-#include "eval/figures.h"
 #include "eval/video.h"
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
@@ -43,7 +41,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-using train::csv_cell;
 
 struct IllustrateOptions {
   std::string env;
@@ -58,6 +55,7 @@ struct IllustrateOptions {
   bool stochastic = false;
   bool jitter = false, position_inaccurate = false, palm_up = false;  // catch only
   bool overwrite = false;  // replace the models already saved under --save_model
+  bool no_progress = false;
   int envs = 1;
   std::uint64_t seed = 0;
   std::vector<std::string> hp;
@@ -81,31 +79,6 @@ std::string learner_name(const std::string& algorithm) {
     }
   }
   throw UserError("--algorithm '" + algorithm + "': expected one of PPO, SAC, TD3, DDPG, A2C");
-}
-
-// Learning curves of a training run, one point per update (NaN where no episode ended).
-struct Curves {
-  std::vector<double> steps, returns, success_rates;
-};
-
-// learning_curve_return.png and learning_curve_success.png in `dir` (matplotlib); true when drawn.
-bool plot_curves(const Curves& c, const std::string& title, const fs::path& dir) {
-  auto series = [&](const std::vector<double>& y, const char* label) {
-    return eval::Series{.label = label, .x = c.steps, .y = y};
-  };
-  eval::Figures figures;
-  figures.add(eval::LinePlot{.title = title + ": training return",
-                             .x_label = "env steps",
-                             .y_label = "return",
-                             .series = {series(c.returns, "episodic return")}},
-              dir / "learning_curve_return.png");
-  figures.add(eval::LinePlot{.title = title + ": training success rate",
-                             .x_label = "env steps",
-                             .y_label = "success rate",
-                             .series = {series(c.success_rates, "success rate")},
-                             .y_range = std::pair{0.0, 1.0}},
-              dir / "learning_curve_success.png");
-  return figures.draw(dir / "figures.json");
 }
 
 // A copy of a file in the temp folder, removed with the object.
@@ -146,7 +119,10 @@ void run(const IllustrateOptions& o) {
   std::map<std::string, std::string> hyperparameters = learn::parse_hyperparameter_flags(o.hp);
   // Models trained before under this name are never replaced silently.
   const fs::path saved = fs::path("models") / o.env / o.save_model;
-  if (o.train_for > 0 && !o.overwrite && fs::exists(saved / "progress.csv")) {
+  const bool trained_before = fs::exists(saved / "model_1.ckpt") ||
+                              fs::exists(saved / "checkpoints") ||
+                              fs::exists(saved / "progress.csv");  // an earlier version's layout
+  if (o.train_for > 0 && !o.overwrite && trained_before) {
     throw UserError("'" + saved.string() +
                     "' holds models trained before; give --overwrite to replace them or another "
                     "--save_model");
@@ -177,14 +153,15 @@ void run(const IllustrateOptions& o) {
   // Training through the one run (train::train): the learner on a vector of envs sharing the
   // compiled scene, a curriculum when given, a model every save_every steps saved from the
   // progress report (one learn() call: episodes run on across saves, as the reference's
-  // callback saves) and named model_<k>.ckpt, progress.csv per update, learning curves.
+  // callback saves) and named model_<k>.ckpt, the run's progress bar, logs and curves.
   train::CheckpointLearner tested;  // the policy tested below (none: random actions)
   if (o.train_for > 0) {
     std::error_code ec;
     // A model of the folder that --overwrite clears is read from a copy taken first.
     std::optional<TempCopy> staged;
     if (!o.load_model.empty()) staged.emplace(o.load_model);
-    // --overwrite: the earlier run's models, curves and run files go.
+    // --overwrite: the earlier run's models go (and an earlier version's curves and logs; the
+    // run replaces its own folders).
     if (o.overwrite) {
       for (const auto& entry : fs::directory_iterator(dir, ec)) {
         const std::string name = entry.path().filename().string();
@@ -193,21 +170,12 @@ void run(const IllustrateOptions& o) {
           fs::remove(entry.path(), ec);
       }
     }
-    make_folder(dir, "cannot create");
-    std::ofstream csv(dir / "progress.csv");
-    if (!csv) throw UserError("cannot write '" + (dir / "progress.csv").string() + "'");
-    csv << "global_step,time,charts/SPS,charts/episodic_return,charts/episodic_length,"
-           "charts/success_rate,episodes\n";
     const long first = staged ? learn::read_checkpoint_info(staged->path).steps : 0;
     int saved = 0;
-    long last_report = first;
     const auto start = Clock::now();
     std::printf("training %s on %s for %ld steps (%d envs) -> %s\n", algorithm.c_str(), id.c_str(),
                 o.train_for, o.envs, dir.c_str());
-    // The success rate of the episodes that ended since the last update.
-    long successes = 0, ended = 0;
-    int success_flag = -1;
-    Curves curves;
+    std::fflush(stdout);
     train::TrainOptions to{.env = id,
                            .algorithm = algorithm,
                            .intrinsic = "",
@@ -219,42 +187,9 @@ void run(const IllustrateOptions& o) {
                            .checkpoint_every = o.save_every,
                            .hyperparameters = hyperparameters,
                            .eval_episodes = 0,
-                           .progress_bar = false,
+                           .progress_bar = !o.no_progress,
                            .task_space = o.task_space,
                            .teacher = o.teacher};
-    to.reward_hook = [&](const learn::VecEnv& env, std::span<const double>, std::span<double>) {
-      if (success_flag < 0) success_flag = env.info(0).find("is_success");
-      for (int i = 0; i < env.num_envs(); ++i) {
-        if (env.terminated()[i] || env.truncated()[i]) {
-          ++ended;
-          successes += env.info(i).flag(success_flag);
-        }
-      }
-    };
-    long successes_seen = 0, ended_seen = 0;
-    to.on_report = [&](const learn::TrainStats& s) {
-      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-      const double rate = ended > ended_seen ? static_cast<double>(successes - successes_seen) /
-                                                   static_cast<double>(ended - ended_seen)
-                                             : std::nan("");
-      successes_seen = successes;
-      ended_seen = ended;
-      csv << s.steps << "," << csv_cell(elapsed) << "," << csv_cell(s.sps) << ","
-          << csv_cell(s.episodic_return) << "," << csv_cell(s.episodic_length) << ","
-          << csv_cell(rate) << "," << s.episodes << "\n";
-      csv.flush();
-      curves.steps.push_back(static_cast<double>(s.steps));
-      curves.returns.push_back(s.episodic_return);
-      curves.success_rates.push_back(rate);
-      if (s.steps - last_report >= std::max<long>(o.train_for / 20, 1) ||
-          s.steps >= first + o.train_for) {
-        last_report = s.steps;
-        std::printf("  %9ld steps  %6.0f s  %6.0f steps/s  return %s  length %s  success %s\n",
-                    s.steps, elapsed, s.sps, csv_cell(s.episodic_return).c_str(),
-                    csv_cell(s.episodic_length).c_str(), csv_cell(rate).c_str());
-        std::fflush(stdout);
-      }
-    };
     // Each saved checkpoint is also model_<k>.ckpt, the reference's name (a hard link).
     long saved_at = first;
     auto name_model = [&](const fs::path& checkpoint, long steps) {
@@ -279,10 +214,8 @@ void run(const IllustrateOptions& o) {
       std::printf("curriculum: training episodes booked in %s\n",
                   (dir / "logs" / "teacher.jsonl").c_str());
     }
-    if (!curves.steps.empty() &&
-        plot_curves(curves, id + " " + (o.algorithm.empty() ? algorithm : o.algorithm), dir)) {
-      std::printf("learning curves: %s/learning_curve_{return,success}.png\n", dir.c_str());
-    }
+    std::printf("progress: %s; learning curves: %s\n", (dir / "logs" / "progress.csv").c_str(),
+                (dir / "plots").c_str());
     tested = train::load_learner(trained.checkpoint, id, env_options, hyperparameters, o.seed);
   } else if (!o.load_model.empty()) {
     tested = train::load_learner(o.load_model, id, env_options, hyperparameters, o.seed);
@@ -401,6 +334,7 @@ void register_illustrate(CLI::App& app) {
   cmd->add_option("--load_model", o->load_model, "Model checkpoint to start from");
   cmd->add_option("--save_model", o->save_model, "Name: models are saved in models/<env>/<name>");
   cmd->add_flag("--overwrite", o->overwrite, "Replace the models saved before under --save_model");
+  cmd->add_flag("--no-progress", o->no_progress, "No progress bar");
   cmd->add_flag("--render_video", o->render_video, "Film every test episode (episode_<i>.mp4)");
   cmd->add_flag("--use_muscles,--use_muscle", o->use_muscles,
                 "Muscle actuation instead of spring-damper motors");

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -43,35 +44,30 @@ namespace fs = std::filesystem;
 using namespace cradle::learn;
 using Clock = std::chrono::steady_clock;
 
-// Columns of logs/progress.csv, CleanRL's names.
-const char* const kColumns[] = {"global_step",
-                                "time",
-                                "charts/SPS",
-                                "charts/episodic_return",
-                                "charts/episodic_length",
-                                "behaviour/score",
-                                "losses/value_loss",
-                                "losses/policy_loss",
-                                "losses/entropy",
-                                "losses/approx_kl",
-                                "losses/clip_fraction",
-                                "losses/explained_variance",
-                                "charts/learning_rate",
-                                "losses/qf_loss",
-                                "losses/actor_loss",
-                                "losses/alpha",
-                                "losses/alpha_loss",
-                                "losses/qf1_values",
-                                "perf/collect_seconds",
-                                "perf/update_seconds"};
+// Columns of logs/progress.csv, CleanRL's names: the run's own, then "charts/success_rate" for
+// envs whose info has "is_success", then the learner's report keys under their group's prefix
+// (then the keys of its own, extra_report_keys, as "losses/<key>").
+const char* const kRunColumns[] = {
+    "global_step",    "time", "charts/SPS", "charts/episodic_return", "charts/episodic_length",
+    "behaviour/score"};
+constexpr int kSuccessColumn = static_cast<int>(std::size(kRunColumns));
+const char* const kReportColumns[] = {
+    "losses/value_loss",    "losses/policy_loss",   "losses/entropy",
+    "losses/approx_kl",     "losses/clip_fraction", "losses/explained_variance",
+    "charts/learning_rate", "losses/qf_loss",       "losses/actor_loss",
+    "losses/alpha",         "losses/alpha_loss",    "losses/qf1_values",
+    "perf/collect_seconds", "perf/update_seconds"};
 
-double loss(const TrainStats& s, const char* name) {
-  const auto it = s.losses.find(name);
+// A report key's value (NaN when the learner does not report it).
+double loss(const TrainStats& s, const std::string& key) {
+  const auto it = s.losses.find(key);
   return it == s.losses.end() ? std::nan("") : it->second;
 }
 
-// Learning curves from progress.csv's rows (matplotlib).
-void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& dir) {
+// Learning curves from progress.csv's rows (matplotlib): the return, and where the run has them
+// the behaviour score and the success rate (column `success`, -1: none).
+void plot_curves(const std::vector<std::vector<double>>& rows, bool intrinsic, int success,
+                 const fs::path& dir) {
   auto series = [&](int column, const char* label) {
     eval::Series s{.label = label};
     for (const auto& r : rows) {
@@ -83,7 +79,8 @@ void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& d
     return s;
   };
   eval::Figures figures;
-  figures.add(eval::LinePlot{.title = "Training: episodic return (env + intrinsic)",
+  figures.add(eval::LinePlot{.title = intrinsic ? "Training: episodic return (env + intrinsic)"
+                                                : "Training: episodic return",
                              .x_label = "env steps",
                              .y_label = "return",
                              .series = {series(3, "episodic return")}},
@@ -96,6 +93,15 @@ void plot_curves(const std::vector<std::vector<double>>& rows, const fs::path& d
                                .y_label = "score",
                                .series = {std::move(score)}},
                 dir / "learning_curve_score.png");
+  }
+  // Envs whose info says "is_success" (drawn even before the first episode ends).
+  if (success >= 0) {
+    figures.add(eval::LinePlot{.title = "Training: success rate",
+                               .x_label = "env steps",
+                               .y_label = "success rate",
+                               .series = {series(success, "success rate")},
+                               .y_range = std::pair{0.0, 1.0}},
+                dir / "learning_curve_success.png");
   }
   figures.draw(dir / "figures.json");
 }
@@ -125,13 +131,15 @@ void check_same_command(GradSync& sync, const std::vector<std::pair<std::string,
 // Data-parallel: the ranks' episodes and scores pooled into `stats`; returns whether any rank
 // was asked to stop (so that all stop at the same update).
 bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& score_count,
-                   bool stop) {
+                   long& successes, long& ended, bool stop) {
   const bool none = stats.episodes == 0;
   std::vector<double> sums = {static_cast<double>(stats.episodes),
                               none ? 0 : stats.episodes * stats.episodic_return,
                               none ? 0 : stats.episodes * stats.episodic_length,
                               score_sum,
                               static_cast<double>(score_count),
+                              static_cast<double>(successes),
+                              static_cast<double>(ended),
                               stop ? 1.0 : 0.0};
   sync.all_reduce_sum(sums);
   stats.episodes = static_cast<int>(sums[0]);
@@ -139,7 +147,9 @@ bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& sc
   stats.episodic_length = sums[0] > 0 ? sums[2] / sums[0] : std::nan("");
   score_sum = sums[3];
   score_count = static_cast<int>(sums[4]);
-  return sums[5] > 0;
+  successes = static_cast<long>(sums[5]);
+  ended = static_cast<long>(sums[6]);
+  return sums[7] > 0;
 }
 
 }  // namespace
@@ -199,9 +209,12 @@ struct Run {
   // make_vector
   TrainingVector training;
   std::unique_ptr<intrinsic::Composite> reward;
-  // make_learner: the behaviour scores of the episodes ended since the last progress row.
+  // make_learner: the behaviour scores of the episodes ended since the last progress row, and
+  // (envs whose info has "is_success", the info's slot; -1: none) their successes.
   double score_sum = 0;
   int score_count = 0;
+  int success_slot = -1;
+  long successes = 0, ended = 0;
   std::unique_ptr<Learner> learner;
   // A run that resets its learner: the run's steps before the current learner's, and how many
   // fresh learners it has made.
@@ -370,6 +383,11 @@ void check_options(Run& run) {
   }
 }
 
+// A rank's teacher book: its path in the run folder (the checkpoint records its size by it).
+std::string teacher_book(int rank) {
+  return rank == 0 ? "logs/teacher.jsonl" : "ranks/" + std::to_string(rank) + "/logs/teacher.jsonl";
+}
+
 // The run folder: one that holds a run (a checkpoint, or progress rows) is never replaced
 // silently: --resume continues it, --overwrite replaces it (its checkpoints, logs and plots go
 // first), anything else is refused. A resumed BabyBench run's training log is cut back to the
@@ -403,9 +421,20 @@ void open_run_folder(Run& run) {
       }
     }
   }
-  // An experiment's logs cut back to what the checkpoint knows (later lines kept aside).
-  if (options.resume && options.experiment && run.rank == 0) {
-    for (const std::string& log : options.experiment->logs()) {
+  // The logs whose sizes the checkpoint records (this rank's teacher book, an experiment's) cut
+  // back to them, later lines kept aside; the book is checked whole first, so that a damaged one
+  // changes nothing.
+  if (options.resume) {
+    std::vector<std::string> logs;
+    if (run.curriculum_spec) {
+      logs.push_back(teacher_book(run.rank));
+      const fs::path book = run.dir / logs.back();
+      if (fs::exists(book)) check_teacher_book(book, run.curriculum_spec->space->dims());
+    }
+    if (options.experiment && run.rank == 0) {
+      for (const std::string& log : options.experiment->logs()) logs.push_back(log);
+    }
+    for (const std::string& log : logs) {
       const auto size = run.resumed.log_sizes.find(log);
       if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(run.dir / log, size->second);
     }
@@ -420,14 +449,10 @@ void open_run_folder(Run& run) {
   }
 }
 
-// A rank's teacher book: its path in the run folder (the checkpoint records its size by it).
-std::string teacher_book(int rank) {
-  return rank == 0 ? "logs/teacher.jsonl" : "ranks/" + std::to_string(rank) + "/logs/teacher.jsonl";
-}
-
 // With a task space, the teacher's controller (one per rank), the wrapper through which it sets
-// every env's reset options, and its book, logs/teacher.jsonl: on resume cut back to what the
-// checkpoint knows (episodes booked after it are played again) and replayed into the teacher.
+// every env's reset options, and its book, logs/teacher.jsonl: on resume (cut back to what the
+// checkpoint knows by open_run_folder: episodes booked after it are played again) replayed into
+// the teacher.
 void make_curriculum(Run& run) {
   if (!run.curriculum_spec) return;
   const TrainOptions& options = run.options;
@@ -438,10 +463,6 @@ void make_curriculum(Run& run) {
     run.curriculum =
         make_controller(spec, options.teacher_factory(*spec.space, teacher_seed), teacher_seed);
   if (options.resume && fs::exists(teacher_file)) {
-    // Every line checked before the book is cut or replayed: a damaged book changes nothing.
-    check_teacher_book(teacher_file, spec.space->dims());
-    const auto size = run.resumed.log_sizes.find(teacher_book(run.rank));
-    if (size != run.resumed.log_sizes.end()) cut_to_checkpoint(teacher_file, size->second);
     replay_teacher_book(*run.curriculum, teacher_file, /*periodical=*/true);
     // The controller's step count at the checkpoint (its last booked episode may be earlier).
     const auto steps = run.resumed.teacher_steps.find(teacher_book(run.rank));
@@ -456,9 +477,9 @@ void make_curriculum(Run& run) {
   run.teacher_log.emplace(teacher_file, options.resume);
 }
 
-// The teacher's new episodes and task snapshots (and with `dump` its state) to
+// The teacher's new episodes and task snapshots (and with `dump_at`, its state at that step) to
 // logs/teacher.jsonl; an experiment hears each episode.
-void write_teacher_log(Run& run, bool dump) {
+void write_teacher_log(Run& run, std::optional<long> dump_at = std::nullopt) {
   if (!run.teacher_log) return;
   Experiment* experiment = run.rank == 0 ? run.options.experiment.get() : nullptr;
   for (const teach::EpisodeRecord& e : run.curriculum->take_episodes()) {
@@ -468,9 +489,7 @@ void write_teacher_log(Run& run, bool dump) {
   for (const teach::PeriodicalRecord& p : run.curriculum->take_periodical())
     run.teacher_log->write(
         {{"kind", "periodical"}, {"env_steps", p.env_steps}, {"tasks", p.tasks}});
-  if (dump)
-    run.teacher_log->write(
-        teach::dump_line(run.curriculum->env_steps(), run.curriculum->teacher_dump()));
+  if (dump_at) run.teacher_log->write(teach::dump_line(*dump_at, run.curriculum->teacher_dump()));
   run.teacher_log->flush();
 }
 
@@ -490,6 +509,8 @@ void make_vector(Run& run) {
                                                      options.seed + run.rank, run.kept_episodes,
                                                      run.wrap, options.async_batch, options.procs);
   VecEnv& vec = *run.training.vec;
+  // Gymnasium's convention: an env that says "is_success" at an episode's end has a success rate.
+  run.success_slot = vec.info(0).find("is_success");
   for (int i = 0; i < vec.num_envs() && options.randomize_start; ++i) {
     vec.env(i).set_reset_options({{"randomize_start", 1}});
   }
@@ -502,8 +523,8 @@ void make_vector(Run& run) {
 }
 
 // A fresh learner (the run's k-th after k resets, seeded apart). Its reward hook adds the
-// intrinsic rewards and the caller's terms, and tallies the behaviour score of each episode that
-// ends (async: the batch, whose slot i is env env_id(i)).
+// intrinsic rewards and the caller's terms, and tallies the behaviour score and the success of
+// each episode that ends (async: the batch, whose slot i is env env_id(i)).
 std::unique_ptr<Learner> fresh_learner(Run& run) {
   const TrainOptions& options = run.options;
   LearnerOptions lo{.seed = options.seed + run.rank + 7919 * static_cast<std::uint64_t>(run.resets),
@@ -520,6 +541,10 @@ std::unique_ptr<Learner> fresh_learner(Run& run) {
         if (!std::isnan(s)) {
           run.score_sum += s;
           ++run.score_count;
+        }
+        if (run.success_slot >= 0) {
+          run.successes += env.info(i).flag(run.success_slot);
+          ++run.ended;
         }
       }
     }
@@ -571,7 +596,9 @@ void open_logs(Run& run) {
   }
   run.csv_file = run.dir / "logs" / "progress.csv";
   // The learner's own report keys follow the common columns (SaMI's: its SaNCE loss and weight).
-  std::vector<std::string> columns(std::begin(kColumns), std::end(kColumns));
+  std::vector<std::string> columns(std::begin(kRunColumns), std::end(kRunColumns));
+  if (run.success_slot >= 0) columns.push_back("charts/success_rate");
+  columns.insert(columns.end(), std::begin(kReportColumns), std::end(kReportColumns));
   run.extra = extra_report_keys(run.algorithm);
   for (const std::string& key : run.extra) columns.push_back("losses/" + key);
   std::string header;
@@ -613,7 +640,7 @@ void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
                  .learner_resets = run.resets};
   // The teacher books of every rank as long as the episodes the checkpoint knows.
   if (run.teacher_log) {
-    write_teacher_log(run, false);
+    write_teacher_log(run);
     // Each rank's size and step count in its slots, summed over the ranks.
     const int ranks = run.sync ? run.sync->world_size() : 1;
     std::vector<double> counts(2 * ranks, 0.0);
@@ -669,13 +696,10 @@ RunView view(const Run& run) {
 // An experiment's evaluation (rank 0) after the teacher's book has every ended episode, then the
 // teacher's state in the book at the run's step.
 void evaluate(Run& run) {
-  write_teacher_log(run, false);
+  write_teacher_log(run);
   if (run.rank == 0) {
     run.options.experiment->evaluate(view(run));
-    if (run.teacher_log) {
-      run.teacher_log->write(teach::dump_line(run.steps(), run.curriculum->teacher_dump()));
-      run.teacher_log->flush();
-    }
+    write_teacher_log(run, run.steps());
   }
   run.last_evaluated = run.steps();
 }
@@ -719,7 +743,7 @@ long train_loop(Run& run, TrainResult& result) {
     save_step_checkpoint(run);
   }
   const ProgressBar bar(options.steps, run.first_steps, options.progress_bar && run.rank == 0);
-  double last_score = std::nan("");
+  double last_score = std::nan(""), last_success = std::nan("");
   // Stopping (Ctrl-C) is agreed by every rank of a data-parallel run.
   bool stopped = false;
   auto stopping = [&] { return run.sync ? stopped : options.stop && options.stop->load(); };
@@ -727,40 +751,35 @@ long train_loop(Run& run, TrainResult& result) {
     TrainStats s = local;
     s.steps += run.offset;
     if (run.sync) {
-      stopped = pool_progress(*run.sync, s, run.score_sum, run.score_count,
-                              options.stop && options.stop->load());
+      stopped = pool_progress(*run.sync, s, run.score_sum, run.score_count, run.successes,
+                              run.ended, options.stop && options.stop->load());
     }
     check_finite_losses(s, run.latest);
-    write_teacher_log(run, false);
+    write_teacher_log(run);
     if (run.reward) run.reward->update();
     if (experiment && run.rank == 0) experiment->report(s);
     const double elapsed = std::chrono::duration<double>(Clock::now() - run.start).count();
     if (run.score_count > 0) last_score = run.score_sum / run.score_count;
     const double window_score =
         run.score_count > 0 ? run.score_sum / run.score_count : std::nan("");
+    const double success_rate =
+        run.ended > 0 ? static_cast<double>(run.successes) / run.ended : std::nan("");
+    if (run.ended > 0) last_success = success_rate;
     run.score_sum = 0;
     run.score_count = 0;
+    run.successes = 0;
+    run.ended = 0;
     std::vector<double> row = {static_cast<double>(s.steps),
                                elapsed,
                                s.sps,
                                s.episodic_return,
                                s.episodic_length,
-                               window_score,
-                               loss(s, "value_loss"),
-                               loss(s, "policy_loss"),
-                               loss(s, "entropy"),
-                               loss(s, "approx_kl"),
-                               loss(s, "clip_fraction"),
-                               loss(s, "explained_variance"),
-                               loss(s, "learning_rate"),
-                               loss(s, "qf_loss"),
-                               loss(s, "actor_loss"),
-                               loss(s, "alpha"),
-                               loss(s, "alpha_loss"),
-                               loss(s, "qf1_values"),
-                               loss(s, "collect_seconds"),
-                               loss(s, "update_seconds")};
-    for (const std::string& key : run.extra) row.push_back(loss(s, key.c_str()));
+                               window_score};
+    if (run.success_slot >= 0) row.push_back(success_rate);
+    // A report column's key is its name after the group ("losses/alpha": alpha).
+    for (const std::string column : kReportColumns)
+      row.push_back(loss(s, column.substr(column.find('/') + 1)));
+    for (const std::string& key : run.extra) row.push_back(loss(s, key));
     for (size_t c = 0; c < row.size(); ++c) run.csv << (c ? "," : "") << csv_cell(row[c]);
     run.csv << "\n";
     run.csv.flush();
@@ -776,7 +795,8 @@ long train_loop(Run& run, TrainResult& result) {
     bar.show(s.steps, elapsed,
              experiment ? experiment->status()
                         : "return " + csv_cell(s.episodic_return) +
-                              (run.by_id ? "" : "  score " + csv_cell(last_score)));
+                              (run.by_id ? "" : "  score " + csv_cell(last_score)) +
+                              (run.success_slot < 0 ? "" : "  success " + csv_cell(last_success)));
     return true;
   };
   LoopOptions loop{.total_steps = options.steps,
@@ -820,7 +840,7 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   if (run.steps() >= next_checkpoint) files.push_back(step);
   // The teacher's state closes its book before the checkpoint records the book's size (an
   // experiment's evaluations dumped it already).
-  write_teacher_log(run, !options.experiment);
+  if (run.curriculum && !options.experiment) write_teacher_log(run, run.curriculum->env_steps());
   save_checkpoint(run, files);
   if (run.rank == 0 && options.on_checkpoint && files.back() == step) options.on_checkpoint(step);
   VecEnv& vec = *run.training.vec;
@@ -838,7 +858,9 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   if (run.rank > 0) return;  // rank 0 draws, scores and evaluates the run
   const bool stopped = options.stop && options.stop->load();
   if (options.experiment) options.experiment->finish(view(run), stopped);
-  if (!run.rows.empty()) plot_curves(run.rows, run.dir / "plots");
+  if (!run.rows.empty())
+    plot_curves(run.rows, run.reward != nullptr, run.success_slot >= 0 ? kSuccessColumn : -1,
+                run.dir / "plots");
   // The score of the whole run's log (a resumed run's earlier episodes included).
   if (!run.by_id && fs::exists(run.log_file))
     result.training_score = eval::training_score(

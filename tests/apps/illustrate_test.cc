@@ -61,13 +61,19 @@ TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {
   EXPECT_TRUE(fs::exists(models / "model_1.ckpt"));
   EXPECT_TRUE(fs::exists(models / "model_2.ckpt"));
   EXPECT_FALSE(fs::exists(models / "model_3.ckpt"));
-  EXPECT_TRUE(fs::exists(models / "progress.csv"));
+  // The run's progress rows carry the training success rate (the env's "is_success").
+  std::ifstream progress(models / "logs" / "progress.csv");
+  std::string header;
+  ASSERT_TRUE(std::getline(progress, header));
+  EXPECT_NE(header.find("behaviour/score,charts/success_rate,losses/"), std::string::npos)
+      << header;
+  EXPECT_FALSE(fs::exists(models / "progress.csv"));
   // The models are the run's step checkpoints under the reference's names (train::train's run).
   EXPECT_TRUE(fs::equivalent(models / "model_1.ckpt", models / "checkpoints" / "step_32.ckpt"));
   EXPECT_TRUE(fs::equivalent(models / "model_2.ckpt", models / "checkpoints" / "step_64.ckpt"));
   // Curves are drawn even when no training episode ended yet (reach lasts 1000 steps).
-  EXPECT_GT(fs::file_size(models / "learning_curve_return.png"), 0u);
-  EXPECT_GT(fs::file_size(models / "learning_curve_success.png"), 0u);
+  EXPECT_GT(fs::file_size(models / "plots" / "learning_curve_return.png"), 0u);
+  EXPECT_GT(fs::file_size(models / "plots" / "learning_curve_success.png"), 0u);
   EXPECT_GT(fs::file_size(models / "episode_0.mp4"), 0u);
   EXPECT_NE(r.out.find("success rate"), std::string::npos) << r.out;
 

@@ -260,6 +260,11 @@ TEST(TmaRun, FinishedRunsAndDamagedFilesAreRefused) {
     std::ofstream out(book_file, std::ios::trunc);
     for (const std::string& l : book) out << l << "\n";
   }
+  // A book that is gone: the teacher's history cannot be replayed.
+  fs::rename(book_file, dir / "book.kept");
+  one_line_naming(run_cradle(resume), "teacher.jsonl' is shorter than at the checkpoint");
+  EXPECT_EQ(read_lines(dir / "progress.csv"), progress);
+  fs::rename(dir / "book.kept", book_file);
   // An output path that cannot be a folder.
   one_line_naming(run_cradle(kSac + "--nb_env_steps 0.001 --out /proc/cradle_x"),
                   "cannot create the run folder '/proc/cradle_x'");

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "envs/sami/sami_env.h"
 #include "fixture.h"
 #include "learn/learner.h"
+#include "learn/vector_env.h"
 #include "train/trainer.h"
 
 namespace cradle::test {
@@ -126,6 +129,69 @@ TEST(EnvMatrix, SamiLearnersTrainOnSamiAndOnOtherFamilies) {
 
 // A teacher over SaMI's hidden parameters: ALP-GMM picks mass and damping for every episode and
 // the env runs with them (a curriculum meta-RL run the reference does not offer).
+// An env whose info says "is_success" gets charts/success_rate: each row's rate is the successes
+// over the episodes that ended since the last row (empty when none ended); BabyBench's has none.
+TEST(EnvMatrix, ProgressRowsCarryTheSuccessRateOfTheEpisodesEndedSinceTheLast) {
+  const fs::path dir = fresh_dir("env_matrix_success");
+  Config config;
+  config.save_dir = dir.string();
+  train::TrainOptions o{.env = "tma/stump-tracks:old_classic_bipedal",
+                        .algorithm = "ppo",
+                        .intrinsic = "",
+                        .steps = 1024,
+                        .envs = 2};
+  o.threads = 2;
+  o.checkpoint_every = 1024;
+  o.eval_episodes = 0;
+  o.progress_bar = false;
+  o.hyperparameters = {{"n_steps", "64"}, {"batch_size", "64"}, {"n_epochs", "1"}};
+  // The test's own tally of the ended episodes (a walker that falls ends its episode).
+  long ended = 0, successes = 0;
+  std::vector<std::pair<long, long>> per_row;
+  o.reward_hook = [&](const learn::VecEnv& env, std::span<const double>, std::span<double>) {
+    const int slot = env.info(0).find("is_success");
+    for (int i = 0; i < env.num_envs(); ++i) {
+      if (env.terminated()[i] || env.truncated()[i]) {
+        ++ended;
+        successes += env.info(i).flag(slot);
+      }
+    }
+  };
+  o.on_report = [&](const learn::TrainStats&) {
+    per_row.emplace_back(successes, ended);
+    successes = ended = 0;
+  };
+  train::train(config, o);
+  std::ifstream in(dir / "logs" / "progress.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_NE(line.find(",behaviour/score,charts/success_rate,losses/value_loss,"),
+            std::string::npos);
+  long total = 0;
+  for (const auto& [s, e] : per_row) {
+    ASSERT_TRUE(std::getline(in, line));
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_GT(cells.size(), 6u);
+    if (e == 0) {
+      EXPECT_EQ(cells[6], "");
+    } else {
+      EXPECT_DOUBLE_EQ(std::stod(cells[6]), static_cast<double>(s) / static_cast<double>(e));
+    }
+    total += e;
+  }
+  EXPECT_EQ(per_row.size(), 8u);
+  EXPECT_GT(total, 0);  // random walkers fall within 1,024 steps
+  // A BabyBench config's rows have no such column.
+  const fs::path babybench = dir / "babybench";
+  short_run("babybench/selftouch", "ppo", 64, babybench);
+  std::ifstream bb(babybench / "logs" / "progress.csv");
+  ASSERT_TRUE(std::getline(bb, line));
+  EXPECT_EQ(line.find("success_rate"), std::string::npos) << line;
+  fs::remove_all(dir);
+}
+
 TEST(EnvMatrix, AlpGmmDrivesSamiMassAndDamping) {
   const fs::path dir = fresh_dir("env_matrix_sami_curriculum");
   Config config;
