@@ -243,13 +243,8 @@ void run(const IllustrateOptions& o) {
               !tested.learner ? "random actions"
               : o.stochastic  ? "the trained policy (sampled actions)"
                               : "the trained policy");
-  struct Episode {
-    double ret = 0;
-    int length = 0;
-    bool success = false;
-  };
-  std::vector<Episode> episodes;  // the ones that ended
-  Episode cut;                    // the one the budget cut short
+  std::vector<train::EpisodeOutcome> episodes;  // the ones that ended
+  train::EpisodeOutcome cut;                    // the one the budget cut short
   long left = o.test_for;
   learn::Learner* l = tested.learner.get();
   const train::EpisodePolicy policy{
@@ -293,22 +288,21 @@ void run(const IllustrateOptions& o) {
     if (video) video->close();
     const train::EpisodeOutcome& e = played.front();
     left -= e.length;
-    const Episode done{.ret = e.episode_return, .length = e.length, .success = mimo->success()};
     if (!ended) {
-      cut = done;
+      cut = e;
       break;
     }
-    std::printf("  episode %zu: %d steps, return %.2f, %s\n", episodes.size(), done.length,
-                done.ret, done.success ? "success" : "no success");
-    episodes.push_back(done);
+    std::printf("  episode %zu: %d steps, return %.2f, %s\n", episodes.size(), e.length,
+                e.episode_return, e.success ? "success" : "no success");
+    episodes.push_back(e);
   }
   if (video) video->close();
   // An episode cut short by the end of testing counts only when none ended.
   if (episodes.empty()) episodes.push_back(cut);
   double returns = 0;
   int successes_test = 0;
-  for (const Episode& e : episodes) {
-    returns += e.ret;
+  for (const train::EpisodeOutcome& e : episodes) {
+    returns += e.episode_return;
     successes_test += e.success;
   }
   const double n = static_cast<double>(episodes.size());
