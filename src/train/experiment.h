@@ -42,6 +42,10 @@ class Experiment {
   virtual void open(const std::filesystem::path& dir, const nlohmann::json* resumed) = 0;
   // Every progress report (the learner's losses and counters).
   virtual void report(const learn::TrainStats& /*stats*/) {}
+  // Columns it adds to the run's logs/progress.csv (after the learner's), and their values at
+  // each progress report, as many (what a resumed run's rows need is part of state()).
+  virtual std::vector<std::string> progress_columns() const { return {}; }
+  virtual std::vector<double> progress_values() const { return {}; }
   // Every training episode the teacher books.
   virtual void booked(const teach::EpisodeRecord& /*episode*/) {}
   // A fresh learner replaced the last one (TrainOptions::reset_every).

@@ -115,6 +115,14 @@ class TmaEvaluations : public Experiment {
       const RunJson state("the checkpoint's evaluation state", *resumed,
                           "the run state of a `cradle tma run` checkpoint");
       evaluation_ = static_cast<int>(std::min(state.count("evaluations"), 1L << 30));
+      // A checkpoint of an earlier version has no last evaluation (nor, stopped before its
+      // first evaluation, one that resumed such a checkpoint): NaN until the next.
+      if (state.has("pct_mastered") && state.json()["pct_mastered"].is_number()) {
+        last_mean_test_return_ = state.number("mean_test_return");
+        last_pct_mastered_ = state.number("pct_mastered");
+      } else {
+        last_mean_test_return_ = last_pct_mastered_ = std::nan("");
+      }
       resumed_ = true;
       wall_before_ = last_wall(dir / "progress.csv");
     }
@@ -133,6 +141,13 @@ class TmaEvaluations : public Experiment {
     updates_seen_ = it->second;
   }
   void learner_replaced() override { updates_seen_ = 0; }
+  // The last evaluation's in the run's progress rows.
+  std::vector<std::string> progress_columns() const override {
+    return {"eval/mean_test_return", "eval/pct_mastered"};
+  }
+  std::vector<double> progress_values() const override {
+    return {last_mean_test_return_, last_pct_mastered_};
+  }
   void booked(const teach::EpisodeRecord& e) override {
     train_return_sum_ += e.ret;
     ++train_returns_;
@@ -184,12 +199,17 @@ class TmaEvaluations : public Experiment {
     if (!progress_ || !test_csv_)
       throw UserError("cannot write the run's logs in '" + dir_.string() + "'");
     last_pct_mastered_ = pct;
+    last_mean_test_return_ = mean;
     ++evaluations_;
     ++evaluation_;
   }
 
   // No time in it: a checkpoint's bytes are the same in every run of the same command.
-  nlohmann::json state() const override { return {{"evaluations", evaluation_}}; }
+  nlohmann::json state() const override {
+    return {{"evaluations", evaluation_},
+            {"mean_test_return", last_mean_test_return_},
+            {"pct_mastered", last_pct_mastered_}};
+  }
   std::string status() const override { return "mastered " + csv_cell(last_pct_mastered_) + "%"; }
 
   void finish(const RunView& run, bool stopped) override {
@@ -249,7 +269,7 @@ class TmaEvaluations : public Experiment {
   double train_return_sum_ = 0;
   long train_returns_ = 0;
   double updates_done_ = std::nan(""), updates_seen_ = std::nan("");
-  double eval_s_ = 0, last_pct_mastered_ = 0;
+  double eval_s_ = 0, last_pct_mastered_ = 0, last_mean_test_return_ = std::nan("");
   StudentRunResult result_;
 };
 

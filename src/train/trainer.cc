@@ -601,6 +601,10 @@ void open_logs(Run& run) {
   columns.insert(columns.end(), std::begin(kReportColumns), std::end(kReportColumns));
   run.extra = extra_report_keys(run.algorithm);
   for (const std::string& key : run.extra) columns.push_back("losses/" + key);
+  if (options.experiment) {
+    for (const std::string& column : options.experiment->progress_columns())
+      columns.push_back(column);
+  }
   std::string header;
   for (size_t c = 0; c < columns.size(); ++c) header += (c ? "," : "") + columns[c];
   ProgressCut cut;
@@ -780,6 +784,13 @@ long train_loop(Run& run, TrainResult& result) {
     for (const std::string column : kReportColumns)
       row.push_back(loss(s, column.substr(column.find('/') + 1)));
     for (const std::string& key : run.extra) row.push_back(loss(s, key));
+    // An experiment's columns (its hooks are rank 0's; the other ranks write no row).
+    if (experiment) {
+      const std::vector<double> values =
+          run.rank == 0 ? experiment->progress_values()
+                        : std::vector<double>(experiment->progress_columns().size(), std::nan(""));
+      row.insert(row.end(), values.begin(), values.end());
+    }
     for (size_t c = 0; c < row.size(); ++c) run.csv << (c ? "," : "") << csv_cell(row[c]);
     run.csv << "\n";
     run.csv.flush();

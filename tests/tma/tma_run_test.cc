@@ -110,7 +110,17 @@ TEST(TmaRun, SacWritesTheRunFolderAndResumes) {
   EXPECT_EQ(train, episodes);
   EXPECT_EQ(dumps, 3);
   // The run's own files: a progress row per report, the checkpoints of the last evaluation.
-  EXPECT_EQ(read_lines(dir / "logs" / "progress.csv").size(), 3u);  // reports at 1000 and 2000
+  const std::vector<std::string> rows = read_lines(dir / "logs" / "progress.csv");
+  ASSERT_EQ(rows.size(), 3u);  // reports at 1000 and 2000
+  // Their last columns are the experiment's: the last evaluation's (at 1000: the one before
+  // training; at 2000: the one at 1000) mean test return and share mastered.
+  EXPECT_TRUE(rows[0].ends_with(",eval/mean_test_return,eval/pct_mastered")) << rows[0];
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> row = cells(rows[k] + ","), evaluation = cells(progress[k]);
+    ASSERT_GE(row.size(), 2u);
+    EXPECT_EQ(row[row.size() - 2], evaluation[5]) << rows[k];
+    EXPECT_EQ(row[row.size() - 1], evaluation[7]) << rows[k];
+  }
   for (const char* file : {"latest.ckpt", "final.ckpt", "step_2000.ckpt"})
     EXPECT_TRUE(fs::exists(dir / "checkpoints" / file)) << file;
   EXPECT_FALSE(fs::exists(dir / "checkpoints" / "step_1000.ckpt"));  // only the newest kept
@@ -188,6 +198,18 @@ TEST(TmaRun, AKillAfterACheckpointResumesToTheSameFiles) {
     const std::vector<std::string> c = cells(line + ",");
     progress.push_back(c[0] + c[1] + c[2] + c[5] + c[6] + c[7] + c[8] + c[9]);
   }
+  // The run's rows: the step and the experiment's columns (restored from the checkpoint).
+  auto run_rows = [&] {
+    std::vector<std::string> out;
+    for (const std::string& line : read_lines(dir / "logs" / "progress.csv")) {
+      const std::vector<std::string> c = cells(line + ",");
+      out.push_back(c[0] + ";" + c[c.size() - 2] + ";" + c[c.size() - 1]);
+    }
+    return out;
+  };
+  const std::vector<std::string> rows = run_rows();
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_NE(rows[3].substr(rows[3].find(';')), ";;") << rows[3];
 
   // The checkpoint of 2000 steps back, with the files as a kill after 3000 steps left them.
   fs::remove_all(dir / "checkpoints");
@@ -202,6 +224,7 @@ TEST(TmaRun, AKillAfterACheckpointResumesToTheSameFiles) {
     again.push_back(c[0] + c[1] + c[2] + c[5] + c[6] + c[7] + c[8] + c[9]);
   }
   EXPECT_EQ(again, progress);
+  EXPECT_EQ(run_rows(), rows);
   // What the first resume wrote after the checkpoint is kept aside, not lost.
   EXPECT_EQ(read_lines(dir / "test_returns.after-checkpoint.csv").size(), 4u);
   fs::remove_all(saved);
