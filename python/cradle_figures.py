@@ -34,7 +34,10 @@ def line_plot(ax, figure):
         if s.get("points"):
             ax.scatter(x, y, s=12, label=s.get("label") or None)
         else:
-            ax.plot(x, y, linewidth=1.5, label=s.get("label") or None)
+            # A line through fewer than two points draws nothing: mark the point instead.
+            lone = sum(1 for v in y if v == v) < 2
+            ax.plot(x, y, linewidth=1.5, marker="o" if lone else None,
+                    label=s.get("label") or None)
     for y, label in figure.get("h_lines", []):
         ax.axhline(y, linestyle="--", color="0.4", linewidth=1)
         ax.annotate(label, (0, y), xycoords=("axes fraction", "data"), xytext=(4, 3),
