@@ -312,8 +312,9 @@ def run(env="stump-tracks", embodiment="old_classic_bipedal", student="sac", tea
     The same run folder, checks and resume as the CLI (docs/tma_run.md); env_options are the
     body and Parkour options (``motors_torque=...``); hyperparameters and teacher_params are
     dicts (a teacher value as JSON-able data). out defaults to tma_runs/<exp_name>/<exp_name>_s<seed>.
-    Returns a dict: run, env_steps, episodes, evaluations, wall_s, env_steps_per_s,
-    gradient_steps, teacher_s, pct_mastered. Bad inputs raise ValueError (one line).
+    Returns the run's summary.json as a dict (env_steps, episodes, evaluations, wall_s,
+    env_steps_per_s, gradient_steps, teacher_s, pct_mastered, ...; None where there is no value,
+    e.g. PPO's gradient steps) and its folder as "run". Bad inputs raise ValueError (one line).
     """
     a = _cradle.TmaRunArguments()
     a.exp_name, a.env = _text("exp_name", exp_name), _text("env", env)

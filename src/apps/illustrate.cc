@@ -13,7 +13,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -23,6 +23,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/env_film.h"
 #include "core/error.h"
 #include "core/folders.h"
 #include "core/rng.h"
@@ -34,13 +35,13 @@
 #include "learn/vector_env.h"
 #include "train/episodes.h"
 #include "train/loop.h"
+#include "train/run_policy.h"
 #include "train/trainer.h"
 
 namespace cradle::apps {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 struct IllustrateOptions {
   std::string env;
@@ -62,23 +63,17 @@ struct IllustrateOptions {
   std::string task_space, teacher;  // a curriculum (docs/curricula.md)
 };
 
-// The learner's name for a reference algorithm name; HER is refused.
+// The learner registry's name of an algorithm in any case (the reference's: PPO); HER, which the
+// reference accepts but never uses, is not supported.
 std::string learner_name(const std::string& algorithm) {
-  std::string upper = algorithm;
-  std::ranges::transform(upper, upper.begin(), [](unsigned char c) { return std::toupper(c); });
-  if (upper == "HER") {
-    throw UserError(
-        "--algorithm HER is not supported (the reference accepts it but never uses it); use PPO, "
-        "SAC, TD3, DDPG or A2C");
-  }
-  for (const char* known : {"PPO", "SAC", "TD3", "DDPG", "A2C"}) {
-    if (upper == known) {
-      std::string lower = upper;
-      std::ranges::transform(lower, lower.begin(), [](unsigned char c) { return std::tolower(c); });
-      return lower;
-    }
-  }
-  throw UserError("--algorithm '" + algorithm + "': expected one of PPO, SAC, TD3, DDPG, A2C");
+  std::string name = algorithm;
+  std::ranges::transform(name, name.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::vector<std::string>& names = learn::algorithm_names();
+  if (std::ranges::find(names, name) != names.end()) return name;
+  throw UserError(
+      "--algorithm '" + algorithm + "'" +
+      (name == "her" ? " is not supported (the reference accepts it but never uses it)" : "") +
+      ": expected " + learn::algorithm_list() + " (in any case)");
 }
 
 // A copy of a file in the temp folder, removed with the object.
@@ -105,7 +100,7 @@ void run(const IllustrateOptions& o) {
   // No --algorithm: the checkpoint's (--load_model), else none (testing with random actions).
   std::string algorithm = o.algorithm.empty() ? "" : learner_name(o.algorithm);
   if (algorithm.empty() && o.load_model.empty() && o.train_for > 0) {
-    throw UserError("--train_for needs --algorithm (PPO, SAC, TD3, DDPG or A2C) or --load_model");
+    throw UserError("--train_for needs --algorithm (e.g. PPO) or --load_model");
   }
   if (o.train_for < 0 || o.test_for < 0) throw UserError("--train_for and --test_for must be >= 0");
   if (o.save_every < 1) throw UserError("--save_every must be at least 1");
@@ -118,12 +113,11 @@ void run(const IllustrateOptions& o) {
   }
   std::map<std::string, std::string> hyperparameters = learn::parse_hyperparameter_flags(o.hp);
   // Models trained before under this name are never replaced silently.
-  const fs::path saved = fs::path("models") / o.env / o.save_model;
-  const bool trained_before = fs::exists(saved / "model_1.ckpt") ||
-                              fs::exists(saved / "checkpoints") ||
-                              fs::exists(saved / "progress.csv");  // an earlier version's layout
+  const fs::path dir = fs::path("models") / o.env / o.save_model;
+  const bool trained_before = fs::exists(dir / "model_1.ckpt") || fs::exists(dir / "checkpoints") ||
+                              fs::exists(dir / "progress.csv");  // an earlier version's layout
   if (o.train_for > 0 && !o.overwrite && trained_before) {
-    throw UserError("'" + saved.string() +
+    throw UserError("'" + dir.string() +
                     "' holds models trained before; give --overwrite to replace them or another "
                     "--save_model");
   }
@@ -139,14 +133,14 @@ void run(const IllustrateOptions& o) {
     for (auto& [k, v] : hyperparameters) saved[k] = v;
     hyperparameters = std::move(saved);
   }
-  const fs::path dir = fs::path("models") / o.env / o.save_model;
 
   // The reference passes the actuation model explicitly: muscles only with --use_muscles.
   envs::EnvOptions env_options{{"actuation", o.use_muscles ? "muscle" : "spring_damper"}};
   if (o.jitter) env_options["jitter"] = "true";
   if (o.position_inaccurate) env_options["position_inaccurate"] = "true";
   if (o.palm_up) env_options["palm_up"] = "true";
-  envs::env_maker(id, env_options);  // refuses a bad option before anything is written
+  // The test env (made now, so that a bad option is refused before anything is written).
+  const std::unique_ptr<envs::Env> env = envs::make_env(id, o.seed + 1000, env_options);
   if (!o.teacher.empty() && o.task_space.empty())
     throw UserError("--teacher needs --task-space FILE.yml (the parameters it sets)");
 
@@ -172,7 +166,6 @@ void run(const IllustrateOptions& o) {
     }
     const long first = staged ? learn::read_checkpoint_info(staged->path).steps : 0;
     int saved = 0;
-    const auto start = Clock::now();
     std::printf("training %s on %s for %ld steps (%d envs) -> %s\n", algorithm.c_str(), id.c_str(),
                 o.train_for, o.envs, dir.c_str());
     std::fflush(stdout);
@@ -207,9 +200,8 @@ void run(const IllustrateOptions& o) {
     const train::TrainResult trained = train::train(config, to);
     // The last model, when the budget ends between saves.
     if (trained.steps > saved_at) name_model(trained.checkpoint, trained.steps);
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    std::printf("trained %ld steps in %.0f s; last model: %s\n", trained.steps - first, seconds,
-                (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
+    std::printf("trained %ld steps in %.0f s; last model: %s\n", trained.steps - first,
+                trained.seconds, (dir / ("model_" + std::to_string(saved) + ".ckpt")).c_str());
     if (!o.task_space.empty()) {
       std::printf("curriculum: training episodes booked in %s\n",
                   (dir / "logs" / "teacher.jsonl").c_str());
@@ -222,30 +214,19 @@ void run(const IllustrateOptions& o) {
   }
 
   // Testing: one env, the policy's deterministic action (random actions without a model), one
-  // rollout per episode until the step budget is spent.
+  // rollout per episode until the step budget is spent; with --render_video a film per episode,
+  // from the state after its reset.
   if (o.test_for == 0) return;
-  envs::SampleOptions sample_options;
-  sample_options.actuation =
-      o.use_muscles ? ActuationModel::kMuscle : ActuationModel::kSpringDamper;
-  sample_options.jitter = o.jitter;
-  sample_options.position_inaccurate = o.position_inaccurate;
-  sample_options.palm_up = o.palm_up;
-  const std::unique_ptr<envs::MimoEnv> mimo =
-      envs::make_sample_env(envs::make_sample_assets(id, sample_options), o.seed + 1000);
-  envs::Env* env = mimo.get();
   const Box& space = env->action_space();
   Rng rng(o.seed + 2000);
-  std::vector<std::uint8_t> frame(static_cast<size_t>(mimo->render_size()) * mimo->render_size() *
-                                  3);
-  const double fps = 1.0 / (mimo->definition().frame_skip * mimo->model()->opt.timestep);
+  std::optional<EnvFilm> film;
+  if (o.render_video) film.emplace(*env);
   std::optional<eval::VideoWriter> video;
   std::printf("testing %s for %ld steps with %s\n", id.c_str(), o.test_for,
               !tested.learner ? "random actions"
               : o.stochastic  ? "the trained policy (sampled actions)"
                               : "the trained policy");
-  std::vector<train::EpisodeOutcome> episodes;  // the ones that ended
-  train::EpisodeOutcome cut;                    // the one the budget cut short
-  long left = o.test_for;
+  std::vector<train::EpisodeOutcome> episodes;
   learn::Learner* l = tested.learner.get();
   const train::EpisodePolicy policy{
       .act =
@@ -256,59 +237,46 @@ void run(const IllustrateOptions& o) {
               space.sample(rng, action);
             }
           },
-      // A film per episode, from the state after its reset.
       .new_episode =
           [&] {
             if (l) l->new_episode();
-            if (!o.render_video) return;
+            if (!film) return;
             std::error_code ec;
             fs::create_directories(dir, ec);
             video.emplace(dir / ("episode_" + std::to_string(episodes.size()) + ".mp4"),
-                          mimo->render_size(), mimo->render_size(), fps);
-            mimo->render(frame);
-            video->write(frame);
+                          film->width(), film->height(), film->fps());
+            video->write(film->draw());
           }};
   bool ended = false;  // the last step ended its episode (not the budget)
   const auto on_step = [&](int, const envs::Env&, const envs::StepResult& r) {
     ended = r.terminated || r.truncated;
-    if (video) {
-      mimo->render(frame);
-      video->write(frame);
-    }
+    if (video) video->write(film->draw());
   };
   // The first episode goes on from the env as made (reset with its seed again), the next ones
-  // with its own stream, as the reference's test loop resets.
+  // with its own stream, as the reference's test loop resets. An episode cut short by the end of
+  // testing counts only when none ended.
   const std::uint64_t first_seed = o.seed + 1000;
-  while (left > 0) {
-    const std::vector<train::EpisodeOutcome> played =
-        episodes.empty() && !cut.length
-            ? train::run_episodes(*env, policy, std::span(&first_seed, 1), static_cast<int>(left),
-                                  on_step)
-            : train::run_episodes(*env, policy, 1, static_cast<int>(left), on_step);
+  for (long left = o.test_for; left > 0;) {
+    const train::EpisodeOutcome e =
+        (episodes.empty() ? train::run_episodes(*env, policy, std::span(&first_seed, 1),
+                                                static_cast<int>(left), on_step)
+                          : train::run_episodes(*env, policy, 1, static_cast<int>(left), on_step))
+            .front();
     if (video) video->close();
-    const train::EpisodeOutcome& e = played.front();
     left -= e.length;
     if (!ended) {
-      cut = e;
+      if (episodes.empty()) episodes.push_back(e);
       break;
     }
     std::printf("  episode %zu: %d steps, return %.2f, %s\n", episodes.size(), e.length,
                 e.episode_return, e.success ? "success" : "no success");
     episodes.push_back(e);
   }
-  if (video) video->close();
-  // An episode cut short by the end of testing counts only when none ended.
-  if (episodes.empty()) episodes.push_back(cut);
-  double returns = 0;
-  int successes_test = 0;
-  for (const train::EpisodeOutcome& e : episodes) {
-    returns += e.episode_return;
-    successes_test += e.success;
-  }
-  const double n = static_cast<double>(episodes.size());
-  std::printf("%zu test episodes: success rate %.1f %% (%d/%zu), mean return %.3f\n",
-              episodes.size(), 100.0 * successes_test / n, successes_test, episodes.size(),
-              returns / n);
+  const nlohmann::ordered_json summary = train::episodes_json(episodes);
+  const double rate = summary["success_rate"], n = static_cast<double>(episodes.size());
+  std::printf("%zu test episodes: success rate %.1f %% (%ld/%zu), mean return %.3f\n",
+              episodes.size(), 100.0 * rate, std::lround(rate * n), episodes.size(),
+              summary["mean_return"].get<double>());
   if (o.render_video) std::printf("videos: %s/episode_<i>.mp4\n", dir.c_str());
 }
 
@@ -323,8 +291,9 @@ void register_illustrate(CLI::App& app) {
   cmd->add_option("--test_for", o->test_for, "Env steps of testing");
   cmd->add_option("--save_every", o->save_every, "Env steps between saved models");
   cmd->add_option("--algorithm,--algo", o->algorithm,
-                  "PPO, SAC, TD3, DDPG or A2C (default: the --load_model checkpoint's; without "
-                  "either, testing takes random actions)");
+                  "Learner, in any case: " + learn::algorithm_list() +
+                      " (default: the --load_model checkpoint's; without either, testing takes "
+                      "random actions)");
   cmd->add_option("--load_model", o->load_model, "Model checkpoint to start from");
   cmd->add_option("--save_model", o->save_model, "Name: models are saved in models/<env>/<name>");
   cmd->add_flag("--overwrite", o->overwrite, "Replace the models saved before under --save_model");

@@ -322,20 +322,22 @@ void register_tma(CLI::App& app) {
       a.sync.reset();  // the ranks' group ends with this call
       return run.parameter_hash;
     });
-    const train::StudentRunResult& r = run.result;
     const std::filesystem::path& out = run.out;
-    if (r.stopped && rank > 0) throw Stopped{};
-    if (rank > 0) return;  // rank 0 reports the run
+    if (run.stopped && rank > 0) throw Stopped{};
+    if (rank > 0) return;                           // rank 0 reports the run
+    const nlohmann::ordered_json& r = run.summary;  // summary.json's figures
+    const auto number = [&](const char* key) { return r.at(key).get<double>(); };
     std::printf(
-        "%s: %ld env steps, %ld episodes, %d evaluations, %.1f s, %.0f env steps/s, %.1f "
+        "%s: %.0f env steps, %.0f episodes, %.0f evaluations, %.1f s, %.0f env steps/s, %.1f "
         "gradient steps/s, teacher %.2f%% of the time, %.0f%% mastered\n",
-        out.string().c_str(), r.env_steps, r.episodes, r.evaluations, r.wall_s, r.env_steps_per_s,
-        r.gradient_steps_per_s, 100 * r.teacher_s / std::max(r.wall_s, 1e-9), r.last_pct_mastered);
-    if (r.stopped) {
+        out.string().c_str(), number("env_steps"), number("episodes"), number("evaluations"),
+        number("wall_s"), number("env_steps_per_s"), number("gradient_steps_per_s"),
+        100 * number("teacher_share"), number("pct_mastered"));
+    if (run.stopped) {
       std::printf(
-          "stopped by a signal at %ld env steps; --resume continues from its checkpoint there: "
+          "stopped by a signal at %.0f env steps; --resume continues from its checkpoint there: "
           "cradle tma run ... --out %s --resume\n",
-          r.checkpoint_steps, out.string().c_str());
+          number("checkpoint_env_steps"), out.string().c_str());
       throw Stopped{};  // exit 130: `tma campaign` must not count the seed as finished
     }
   });

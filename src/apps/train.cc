@@ -19,6 +19,7 @@
 #include "envs/registry.h"
 #include "learn/hyperparams.h"
 #include "learn/registry.h"
+#include "train/env_vector.h"
 #include "train/trainer.h"
 
 namespace cradle::apps {

@@ -49,6 +49,19 @@ double agree_mean(GradSync* sync, double value) {
   return value / sync->world_size();
 }
 
+std::string first_disagreement(GradSync& sync,
+                               const std::vector<std::pair<std::string, double>>& values) {
+  // Each value's maximum and the maximum of its negation: equal magnitudes where all agree.
+  std::vector<double> extremes;
+  for (const auto& [name, value] : values) extremes.push_back(value);
+  for (const auto& [name, value] : values) extremes.push_back(-value);
+  sync.all_reduce_max(extremes);
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (extremes[i] != -extremes[values.size() + i]) return values[i].first;
+  }
+  return "";
+}
+
 void offset_generator(GradSync* sync, at::Generator& generator) {
   if (!distributed(sync) || sync->rank() == 0) return;
   const std::lock_guard<std::mutex> lock(generator.mutex());

@@ -10,6 +10,9 @@
 #pragma once
 
 #include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace cradle::learn {
 
@@ -34,5 +37,9 @@ inline int world_size(const GradSync* sync) { return sync != nullptr ? sync->wor
 double agree_max(GradSync* sync, double value);
 // The mean of a value over the ranks (e.g. PPO's approximate KL for its early stop).
 double agree_mean(GradSync* sync, double value);
+// The name of the first value that is not the same on every rank ("" when all agree), e.g. a
+// setting every rank must share for the collectives to pair up.
+std::string first_disagreement(GradSync& sync,
+                               const std::vector<std::pair<std::string, double>>& values);
 
 }  // namespace cradle::learn

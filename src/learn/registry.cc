@@ -40,7 +40,7 @@ std::string join(const std::vector<std::string>& names, std::string_view last) {
 
 [[noreturn]] void unknown(std::string_view algorithm) {
   throw UserError("unknown algorithm '" + std::string(algorithm) + "' (expected " +
-                  join(algorithm_names(), "or") + ")");
+                  algorithm_list() + ")");
 }
 
 }  // namespace
@@ -63,6 +63,8 @@ AlgorithmTraits algorithm_traits(std::string_view algorithm) {
   if (!meta::sami_method(algorithm).empty()) return {.data_parallel = true};
   unknown(algorithm);
 }
+
+std::string algorithm_list() { return join(algorithm_names(), "or"); }
 
 std::string algorithms_with(bool AlgorithmTraits::*trait, std::string_view last) {
   std::vector<std::string> names;

@@ -15,6 +15,8 @@ namespace cradle::learn {
 // "ddpg", then SaMI's context learners "tesac", "ccm", "satesac", "saccm", "saccm_all"
 // (learn/meta/sami_learner.h).
 const std::vector<std::string>& algorithm_names();
+// Every algorithm, for messages: "ppo, a2c, ... or saccm_all".
+std::string algorithm_list();
 
 // Builds a learner by name (one of algorithm_names()). Throws UserError for an unknown algorithm
 // or hyperparameter, a bad value, or an env the learner cannot handle.
@@ -23,7 +25,8 @@ std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
 
 // What an algorithm can do besides training on one process's vector of envs.
 struct AlgorithmTraits {
-  bool data_parallel = false;     // --distributed: gradients averaged over ranks (LearnerOptions::sync)
+  bool data_parallel =
+      false;  // --distributed: gradients averaged over ranks (LearnerOptions::sync)
   bool async_collection = false;  // --async-batch: collects from an AsyncVecEnv in batches
 };
 // UserError naming the algorithms for an unknown name.

@@ -315,4 +315,25 @@ void check_finite_losses(const TrainStats& stats, const fs::path& checkpoint) {
   }
 }
 
+std::ofstream continue_log(const fs::path& file, const std::string& header, bool resume) {
+  bool fresh = !resume;
+  if (resume) {
+    std::ifstream in(file);
+    std::string first;
+    if (!in || !std::getline(in, first)) {
+      fresh = true;
+    } else if (first != header) {
+      in.close();
+      const fs::path kept = keep_aside_before_resume(file);
+      std::cerr << file.filename().string() << ": written with other columns, kept whole as "
+                << kept.string() << "; a fresh one begins\n";
+      fresh = true;
+    }
+  }
+  std::ofstream out(file, fresh ? std::ios::trunc : std::ios::app);
+  if (!out) throw UserError("cannot write '" + file.string() + "'");
+  if (fresh) out << header << "\n";
+  return out;
+}
+
 }  // namespace cradle::learn

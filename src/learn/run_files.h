@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -66,6 +67,13 @@ void cut_to_checkpoint(const std::filesystem::path& file, std::uintmax_t size);
 // Renames a log written with other columns to <stem>.before-resume<ext> beside it (-2, -3, ...
 // after the stem when taken) and returns the new path; UserError when the rename fails.
 std::filesystem::path keep_aside_before_resume(const std::filesystem::path& file);
+
+// A log of `header`'s columns (an experiment's CSV), fresh with its header, or with `resume`
+// (cut back to the checkpoint already) appended to; one written with other columns (another
+// version's) is kept aside whole (keep_aside_before_resume, one line on stderr) and a fresh one
+// begins. UserError when it cannot be written.
+std::ofstream continue_log(const std::filesystem::path& file, const std::string& header,
+                           bool resume);
 
 // progress.csv on resume. When its header is `header`: rows up to `step` are kept, later rows and
 // a torn last line go to progress.after-checkpoint.csv beside it, and `append` is true. With

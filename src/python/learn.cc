@@ -21,7 +21,9 @@
 #include "python/common.h"
 #include "python/python_teacher.h"
 #include "train/babybench_vector.h"
+#include "train/env_vector.h"
 #include "train/evaluation.h"
+#include "train/run_policy.h"
 #include "train/trainer.h"
 
 namespace cradle::python {

@@ -1,10 +1,9 @@
 // cradle.tma.run: `cradle tma run` (train/tma_student.h) from Python, with the same checks and run
 // folder. The GIL is released while C++ trains.
-#include "train/tma_student.h"
-
 #include <string>
 
 #include "python/common.h"
+#include "train/tma_student.h"
 
 namespace cradle::python {
 
@@ -13,17 +12,9 @@ void bind_tma_run(py::module_& m) {
       "tma_run",
       [](const train::TmaRunArguments& a) {
         const train::TmaRun run = without_gil([&] { return train::run_tma(a); });
-        const train::StudentRunResult& r = run.result;
-        py::dict d;
+        // summary.json's figures (null: none, e.g. PPO's gradient steps) and the run folder.
+        py::dict d = py::module_::import("json").attr("loads")(run.summary.dump());
         d["run"] = run.out.string();
-        d["env_steps"] = r.env_steps;
-        d["episodes"] = r.episodes;
-        d["evaluations"] = r.evaluations;
-        d["wall_s"] = r.wall_s;
-        d["env_steps_per_s"] = r.env_steps_per_s;
-        d["gradient_steps"] = r.gradient_steps;
-        d["teacher_s"] = r.teacher_s;
-        d["pct_mastered"] = r.last_pct_mastered;
         return d;
       },
       py::arg("arguments"));

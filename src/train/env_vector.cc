@@ -40,4 +40,17 @@ TrainingVector make_env_training(const std::string& id, int num_envs, int thread
   return out;
 }
 
+std::string registered_env_id(const std::string& name) {
+  // `cradle illustrate`'s short names of the MIMo sample tasks.
+  for (const char* short_name : {"reach", "standup", "selfbody", "catch"})
+    if (name == short_name) return "mimo/" + name;
+  return envs::env_spec(name).id;  // UserError naming the closest ids
+}
+
+std::optional<Config> babybench_config(const std::string& name) {
+  const envs::EnvSpec spec = envs::env_spec(registered_env_id(name));
+  if (spec.family != "babybench") return std::nullopt;
+  return spec.config.empty() ? default_config() : load_config(spec.config);
+}
+
 }  // namespace cradle::train

@@ -3,12 +3,22 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
+#include "core/config.h"
 #include "envs/registry.h"
 #include "train/babybench_vector.h"
 
 namespace cradle::train {
+
+// The registered id of an env name: an id, an alias or a MIMo sample task's short name. UserError
+// naming the closest ids for an unknown one.
+std::string registered_env_id(const std::string& name);
+
+// The config a BabyBench id trains as (the registry's file, or the documented defaults); nullopt
+// for an id of another family. UserError naming the closest ids for an unknown one.
+std::optional<Config> babybench_config(const std::string& name);
 
 // A UserError "<prefix>--envs N does not split evenly over --procs P; ..." unless P divides N.
 void check_procs_split(int num_envs, int procs, const std::string& prefix = "");

@@ -42,17 +42,15 @@ CurriculumSpec tma_curriculum(const envs::EnvSpec& env) {
   return spec;
 }
 
-std::map<std::string, std::string> sami_learner_presets(const envs::EnvSpec& env,
-                                                        const std::string& algorithm) {
-  return sami_presets(env.id, env.max_episode_steps, algorithm);
-}
-
 // The registry: one line per family.
 const std::pair<std::string_view, Family> kFamilies[] = {
     {"babybench", {.curriculum = babybench_curriculum}},
     {"mimo", {.curriculum = declared_space}},
     {"tma", {.curriculum = tma_curriculum}},
-    {"sami", {.presets = sami_learner_presets, .curriculum = declared_space}},
+    {"sami",
+     {.presets = sami_presets,
+      .curriculum = declared_space,
+      .outputs = {"eval_", "contexts_", "checkpoint.ckpt", "progress."}}},
 };
 
 }  // namespace

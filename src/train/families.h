@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "envs/registry.h"
 #include "train/task_space.h"
@@ -22,6 +23,10 @@ struct Family {
   // parameters (never empty here) with the family's facts (return bounds, easy region, what the
   // teacher hears).
   CurriculumSpec (*curriculum)(const envs::EnvSpec& env) = nullptr;
+  // What the family's own tools write in a run folder, by name prefix (SaMI's evaluations, and
+  // an earlier version's checkpoint and progress files): a folder holding one holds a run, and
+  // --overwrite removes them with it.
+  std::vector<std::string> outputs;
 };
 
 // The family of that name (babybench, mimo, tma, sami); UserError naming them for another.

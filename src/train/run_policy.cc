@@ -161,4 +161,35 @@ RunPolicy load_run_policy(const fs::path& run_folder, const std::string& checkpo
   return RunPolicy(std::move(run), file, sampled, std::move(vec), std::move(learner));
 }
 
+CheckpointLearner load_learner(const fs::path& checkpoint, const std::string& env_id,
+                               const envs::EnvOptions& options,
+                               const std::map<std::string, std::string>& overrides,
+                               std::uint64_t seed) {
+  const learn::CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
+  std::map<std::string, std::string> hyperparameters =
+      learn::parse_hyperparameter_text(info.config);
+  for (const auto& [name, value] : overrides) hyperparameters[name] = value;
+  CheckpointLearner out;
+  out.vec = make_env_training(env_id, 1, 1, seed, nullptr, 0, options).vec;
+  out.learner = learn::make_learner(info.algorithm, *out.vec,
+                                    {.seed = seed, .hyperparameters = hyperparameters});
+  out.learner->load(checkpoint);
+  return out;
+}
+
+train::Policy load_policy(const Config& config, const fs::path& checkpoint, bool sampled) {
+  if (!fs::exists(checkpoint)) {
+    throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
+  }
+  const learn::CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
+  // A one-env vector of the config gives the learner its spaces; it is kept alive by the policy.
+  std::shared_ptr<learn::VecEnv> vec = make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
+  learn::LearnerOptions lo{.hyperparameters = learn::parse_hyperparameter_text(info.config)};
+  std::shared_ptr<learn::Learner> learner = learn::make_learner(info.algorithm, *vec, lo);
+  learner->load(checkpoint);
+  return [vec, learner, sampled](const envs::BabyBenchEnv& env, std::span<double> action) {
+    learner->act(env.observation(), action, /*deterministic=*/!sampled);
+  };
+}
+
 }  // namespace cradle::train

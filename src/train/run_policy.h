@@ -1,7 +1,9 @@
 // The trained policy of a run, found by its folder: run.json says which env, family and
 // algorithm the run trained, checkpoints/<name>.ckpt holds the learner. This is the one front
 // door for `cradle evaluate --run DIR` and Python's cradle.load_policy(run_folder), for runs of
-// every family (`cradle train --env ID`, cradle.train(env=...)) and BabyBench configs alike.
+// every family (`cradle train --env ID`, cradle.train(env=...)) and BabyBench configs alike. A
+// bare checkpoint's learner or policy (`cradle illustrate --load_model`, `cradle evaluate
+// --policy`) is loaded here too.
 #pragma once
 
 #include <cstdint>
@@ -14,7 +16,9 @@
 #include "core/config.h"
 #include "core/spaces.h"
 #include "envs/env.h"
+#include "envs/registry.h"
 #include "train/episodes.h"
+#include "train/evaluation.h"
 
 namespace cradle::learn {
 class Learner;
@@ -67,6 +71,8 @@ class RunPolicy {
   void new_episode() const;
   // For train::run_episodes.
   EpisodePolicy episode_policy() const;
+  // The learner itself (e.g. to read a SaMI learner's last context).
+  const learn::Learner& learner() const { return *learner_; }
 
  private:
   RunInfo run_;
@@ -82,5 +88,23 @@ class RunPolicy {
 // algorithm and hyperparameters. Deterministic (the mean action) unless `sampled`.
 RunPolicy load_run_policy(const std::filesystem::path& run_folder,
                           const std::string& checkpoint = "final", bool sampled = false);
+
+// A checkpoint's learner on a one-env vector of an env id (kept with it, the learner acts on it),
+// e.g. to test a trained policy on an env of its own: the checkpoint's hyperparameters with
+// `overrides` over them, seeded `seed` (a checkpoint that restores its generator overrides it).
+struct CheckpointLearner {
+  std::shared_ptr<learn::VecEnv> vec;
+  std::shared_ptr<learn::Learner> learner;
+};
+CheckpointLearner load_learner(const std::filesystem::path& checkpoint, const std::string& env_id,
+                               const envs::EnvOptions& options = {},
+                               const std::map<std::string, std::string>& overrides = {},
+                               std::uint64_t seed = 0);
+
+// The policy of a checkpoint, for `cradle evaluate --policy`: the mean action, or with `sampled`
+// actions drawn from the policy's distribution (as SB3's predict() does by default) by the
+// checkpoint's own generator, so a sampled evaluation of one checkpoint repeats exactly.
+train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,
+                          bool sampled = false);
 
 }  // namespace cradle::train

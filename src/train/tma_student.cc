@@ -37,29 +37,6 @@ const char* const kTestHeader = "evaluation,env_steps,task_index,return,mastered
 // Arguments a resumed run may change.
 const char* const kResumable[] = {"nb_env_steps", "test_every", "resume", "out", "progress_bar"};
 
-// A log continued on resume: its header is the current one, or it is kept aside whole (another
-// version's columns) and a fresh one begins. Returns the stream, appending or fresh with header.
-std::ofstream open_log(const fs::path& file, const std::string& header, bool resume) {
-  bool fresh = !resume;
-  if (resume) {
-    std::ifstream in(file);
-    std::string first;
-    if (!in || !std::getline(in, first)) {
-      fresh = true;
-    } else if (first != header) {
-      in.close();
-      const fs::path kept = learn::keep_aside_before_resume(file);
-      std::cerr << file.filename().string() << ": written with other columns, kept whole as "
-                << kept.string() << "; a fresh one begins\n";
-      fresh = true;
-    }
-  }
-  std::ofstream out(file, fresh ? std::ios::trunc : std::ios::app);
-  if (!out) throw UserError("cannot write '" + file.string() + "'");
-  if (fresh) out << header << "\n";
-  return out;
-}
-
 // The run's wall time at its last evaluation: progress.csv's last wall_s (0 without one).
 double last_wall(const fs::path& progress) {
   std::ifstream in(progress);
@@ -126,8 +103,8 @@ class TmaEvaluations : public Experiment {
       resumed_ = true;
       wall_before_ = last_wall(dir / "progress.csv");
     }
-    progress_ = open_log(dir / "progress.csv", kProgressHeader, resumed != nullptr);
-    test_csv_ = open_log(dir / "test_returns.csv", kTestHeader, resumed != nullptr);
+    progress_ = learn::continue_log(dir / "progress.csv", kProgressHeader, resumed != nullptr);
+    test_csv_ = learn::continue_log(dir / "test_returns.csv", kTestHeader, resumed != nullptr);
     start_ = Clock::now();
   }
 
@@ -213,40 +190,25 @@ class TmaEvaluations : public Experiment {
   std::string status() const override { return "mastered " + csv_cell(last_pct_mastered_) + "%"; }
 
   void finish(const RunView& run, bool stopped) override {
-    result_.env_steps = run.steps;
-    result_.episodes = run.curriculum->episodes();
-    result_.evaluations = evaluations_;
-    result_.wall_s = std::chrono::duration<double>(Clock::now() - start_).count();
-    result_.env_steps_per_s = (run.steps - run.first_steps) / std::max(result_.wall_s, 1e-9);
-    result_.gradient_steps = updates_done_;
-    result_.gradient_steps_per_s = updates_done_ / std::max(result_.wall_s, 1e-9);
-    result_.teacher_s = run.teacher_seconds;
-    result_.eval_s = eval_s_;
-    result_.last_pct_mastered = last_pct_mastered_;
-    result_.stopped = stopped;
-    result_.checkpoint_steps = run.steps;
-    nlohmann::ordered_json summary{
-        {"env_steps", result_.env_steps},
-        {"episodes", result_.episodes},
-        {"evaluations", result_.evaluations},
-        {"wall_s", result_.wall_s},
-        {"env_steps_per_s", result_.env_steps_per_s},
-        {"gradient_steps", result_.gradient_steps},
-        {"gradient_steps_per_s", result_.gradient_steps_per_s},
-        {"teacher_s", result_.teacher_s},
-        {"teacher_share", result_.teacher_s / std::max(result_.wall_s, 1e-9)},
-        {"eval_s", result_.eval_s},
-        {"pct_mastered", result_.last_pct_mastered},
-        {"stopped", result_.stopped},
-        {"checkpoint_env_steps", result_.checkpoint_steps}};
-    if (std::isnan(result_.gradient_steps)) {
-      summary["gradient_steps"] = nullptr;
-      summary["gradient_steps_per_s"] = nullptr;
-    }
-    write_atomically(dir_ / "summary.json", summary.dump(2) + "\n");
+    const double wall_s = std::chrono::duration<double>(Clock::now() - start_).count();
+    summary_ = {{"env_steps", run.steps},
+                {"episodes", run.curriculum->episodes()},
+                {"evaluations", evaluations_},
+                {"wall_s", wall_s},
+                {"env_steps_per_s", (run.steps - run.first_steps) / std::max(wall_s, 1e-9)},
+                {"gradient_steps", updates_done_},
+                {"gradient_steps_per_s", updates_done_ / std::max(wall_s, 1e-9)},
+                {"teacher_s", run.teacher_seconds},
+                {"teacher_share", run.teacher_seconds / std::max(wall_s, 1e-9)},
+                {"eval_s", eval_s_},
+                {"pct_mastered", last_pct_mastered_},
+                {"stopped", stopped},
+                {"checkpoint_env_steps", run.steps}};
+    // NaN (PPO's gradient steps) is written as null.
+    write_atomically(dir_ / "summary.json", summary_.dump(2) + "\n");
   }
 
-  const StudentRunResult& result() const { return result_; }
+  const nlohmann::ordered_json& summary() const { return summary_; }
 
  private:
   // The run's wall time: earlier processes' and this one's.
@@ -270,7 +232,7 @@ class TmaEvaluations : public Experiment {
   long train_returns_ = 0;
   double updates_done_ = std::nan(""), updates_seen_ = std::nan("");
   double eval_s_ = 0, last_pct_mastered_ = 0, last_mean_test_return_ = std::nan("");
-  StudentRunResult result_;
+  nlohmann::ordered_json summary_;
 };
 
 }  // namespace
@@ -352,22 +314,6 @@ std::map<std::string, std::string> student_preset(const std::string& student, lo
   throw UserError("--student '" + student + "' (expected sac or ppo)");
 }
 
-namespace {
-
-// Whether the run folder's run.json records body or Parkour options.
-bool run_has_env_options(const fs::path& dir) {
-  // Only a readable file counts; the resume itself names a damaged one.
-  std::error_code ec;
-  if (!fs::is_regular_file(dir / "run.json", ec)) return false;
-  std::ifstream in(dir / "run.json");
-  if (!in) return false;
-  const nlohmann::json run = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return run.is_object() && run.contains("arguments") && run["arguments"].is_object() &&
-         run["arguments"].contains("env_options");
-}
-
-}  // namespace
-
 TmaRun run_tma(const TmaRunArguments& a) {
   // --steps is the budget in env steps; recorded as the reference's millions.
   const double millions = a.steps > 0 ? static_cast<double>(a.steps) / 1e6 : a.nb_env_steps;
@@ -438,8 +384,7 @@ TmaRun run_tma(const TmaRunArguments& a) {
   // refused by name); runs without them resume as before.
   nlohmann::json env_options = nlohmann::json::object();
   for (const auto& [name, value] : a.env_options) env_options[name] = value;
-  if (!env_options.empty() || (a.resume && run_has_env_options(out)))
-    arguments["env_options"] = env_options;
+  if (!env_options.empty()) arguments["env_options"] = env_options;
 
   // A resume gives the run's arguments again (but the resumable ones); every file checked before
   // anything is cut or changed.
@@ -454,6 +399,7 @@ TmaRun run_tma(const TmaRunArguments& a) {
       throw UserError("--resume: no checkpoint in '" + (out / "checkpoints").string() + "'");
     const RunJson saved(out / "run.json", "the run.json of a `cradle tma run` run");
     const RunJson saved_arguments = saved.object("arguments");
+    if (saved_arguments.has("env_options")) arguments["env_options"] = env_options;
     for (const auto& [key, value] : arguments.items()) {
       if (std::find(std::begin(kResumable), std::end(kResumable), key) != std::end(kResumable))
         continue;
@@ -517,7 +463,6 @@ TmaRun run_tma(const TmaRunArguments& a) {
                              .intrinsic = "",
                              .steps = total_steps,
                              .envs = 1,
-                             .threads = 1,
                              .seed = a.seed,
                              .resume = a.resume,
                              .overwrite = a.overwrite,
@@ -537,10 +482,10 @@ TmaRun run_tma(const TmaRunArguments& a) {
   Config config = default_config();
   config.save_dir = out.string();
   const TrainResult trained = train(config, train_options);
-  StudentRunResult result = evaluations->result();
-  // Ended before its budget: stopped (a signal to any rank of a data-parallel run stops them all).
-  result.stopped = trained.steps < total_steps;
-  return {.out = out, .result = result, .parameter_hash = trained.parameter_hash};
+  return {.out = out,
+          .summary = evaluations->summary(),
+          .stopped = trained.steps < total_steps,
+          .parameter_hash = trained.parameter_hash};
 }
 
 }  // namespace cradle::train

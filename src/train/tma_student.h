@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,22 +37,6 @@ struct StudentEnv {
   double success_threshold = tma::kSuccessReturn;   // return above which a task is mastered
   std::optional<teach::DiagGaussian> initial_dist;  // the easy region (high expert knowledge)
   std::vector<teach::Task> test_set;                // empty: teach::default_test_set
-};
-
-// What a student run did (this process's figures; the run's steps and episodes in total).
-struct StudentRunResult {
-  long env_steps = 0;
-  long episodes = 0;
-  int evaluations = 0;
-  double wall_s = 0;           // this process
-  double env_steps_per_s = 0;  // this process, evaluations included
-  double gradient_steps = 0;   // SAC: updates in this process (NaN for PPO)
-  double gradient_steps_per_s = 0;
-  double teacher_s = 0;  // time inside the teacher controller
-  double eval_s = 0;     // time evaluating
-  double last_pct_mastered = 0;
-  bool stopped = false;       // ended early by `stop`
-  long checkpoint_steps = 0;  // env steps of the checkpoint that --resume continues from
 };
 
 // TeachMyAgent's benchmark as a student env (the facts of the paper's experiments): envs of the
@@ -100,7 +85,12 @@ struct TmaRunArguments {
 };
 struct TmaRun {
   std::filesystem::path out;  // the run folder (default tma_runs/<exp_name>/<exp_name>_s<seed>)
-  StudentRunResult result;    // rank 0's (the evaluations are rank 0's)
+  // What summary.json says (rank 0's; empty on the other ranks): the run's env steps, episodes
+  // and evaluations, this process's wall_s, env_steps_per_s, gradient_steps (SAC's updates; NaN
+  // for PPO) and their rate, teacher_s and teacher_share, eval_s, the last pct_mastered, whether
+  // it stopped, and checkpoint_env_steps (where --resume continues).
+  nlohmann::ordered_json summary;
+  bool stopped = false;              // ended before its budget (a signal to any rank stops all)
   std::uint64_t parameter_hash = 0;  // the trained student's (every rank the same)
 };
 TmaRun run_tma(const TmaRunArguments& arguments);

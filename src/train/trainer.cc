@@ -64,118 +64,78 @@ double loss(const TrainStats& s, const std::string& key) {
   return it == s.losses.end() ? std::nan("") : it->second;
 }
 
-// Learning curves from progress.csv's rows (matplotlib): the return, and where the run has them
-// the behaviour score and the success rate (column `success`, -1: none).
+// Learning curves from progress.csv's rows (matplotlib): the return; the behaviour score where
+// episodes scored one (BabyBench's, Panda push's); the success rate in column `success` (-1:
+// none) where the env's info says "is_success" (drawn before the first episode ends too).
 void plot_curves(const std::vector<std::vector<double>>& rows, bool intrinsic, int success,
                  const fs::path& dir) {
-  auto series = [&](int column, const char* label) {
-    eval::Series s{.label = label};
+  struct Curve {
+    int column;
+    const char *title, *series, *y_label, *file;
+  };
+  const Curve curves[] = {
+      {3, intrinsic ? "Training: episodic return (env + intrinsic)" : "Training: episodic return",
+       "episodic return", "return", "learning_curve_return.png"},
+      {5, "Training: behaviour score per episode", "behaviour score", "score",
+       "learning_curve_score.png"},
+      {success, "Training: success rate", "success rate", "success rate",
+       "learning_curve_success.png"}};
+  eval::Figures figures;
+  for (const Curve& c : curves) {
+    if (c.column < 0) continue;
+    eval::LinePlot plot{.title = c.title, .x_label = "env steps", .y_label = c.y_label};
+    eval::Series& s = plot.series.emplace_back(eval::Series{.label = c.series});
     for (const auto& r : rows) {
-      if (!std::isnan(r[column])) {
+      if (!std::isnan(r[c.column])) {
         s.x.push_back(r[0]);
-        s.y.push_back(r[column]);
+        s.y.push_back(r[c.column]);
       }
     }
-    return s;
-  };
-  eval::Figures figures;
-  figures.add(eval::LinePlot{.title = intrinsic ? "Training: episodic return (env + intrinsic)"
-                                                : "Training: episodic return",
-                             .x_label = "env steps",
-                             .y_label = "return",
-                             .series = {series(3, "episodic return")}},
-              dir / "learning_curve_return.png");
-  // Only envs that score behaviour (BabyBench's, Panda push's success) have a score chart.
-  eval::Series score = series(5, "behaviour score");
-  if (!score.x.empty()) {
-    figures.add(eval::LinePlot{.title = "Training: behaviour score per episode",
-                               .x_label = "env steps",
-                               .y_label = "score",
-                               .series = {std::move(score)}},
-                dir / "learning_curve_score.png");
-  }
-  // Envs whose info says "is_success" (drawn even before the first episode ends).
-  if (success >= 0) {
-    figures.add(eval::LinePlot{.title = "Training: success rate",
-                               .x_label = "env steps",
-                               .y_label = "success rate",
-                               .series = {series(success, "success rate")},
-                               .y_range = std::pair{0.0, 1.0}},
-                dir / "learning_curve_success.png");
+    if (c.column == 5 && s.x.empty()) continue;                   // no episode scored behaviour
+    if (c.column == success) plot.y_range = std::pair{0.0, 1.0};  // a share
+    figures.add(std::move(plot), dir / c.file);
   }
   figures.draw(dir / "figures.json");
 }
 
-// Data-parallel: the name of the first value that is not the same on every rank ("" if none).
-std::string first_difference(GradSync& sync,
-                             const std::vector<std::pair<std::string, double>>& values) {
-  std::vector<double> extremes;
-  for (const auto& [name, value] : values) extremes.push_back(value);
-  for (const auto& [name, value] : values) extremes.push_back(-value);
-  sync.all_reduce_max(extremes);
-  for (size_t i = 0; i < values.size(); ++i) {
-    if (extremes[i] != -extremes[values.size() + i]) return values[i].first;
-  }
-  return "";
-}
+// The behaviour scores and successes of the episodes ended since the last progress row.
+struct EpisodeTally {
+  double score_sum = 0, scored = 0, successes = 0, ended = 0;
+};
 
-// Data-parallel: every rank must run the same command, or the collectives would not pair up.
-void check_same_command(GradSync& sync, const std::vector<std::pair<std::string, double>>& values) {
-  const std::string differs = first_difference(sync, values);
-  if (!differs.empty()) {
-    throw UserError("the ranks run different commands (" + differs +
-                    " differs): start every rank with the same arguments");
-  }
-}
-
-// Data-parallel: the ranks' episodes and scores pooled into `stats`; returns whether any rank
-// was asked to stop (so that all stop at the same update).
-bool pool_progress(GradSync& sync, TrainStats& stats, double& score_sum, int& score_count,
-                   long& successes, long& ended, bool stop) {
+// Data-parallel: the ranks' episodes, scores and successes pooled into `stats` and `tally`;
+// returns whether any rank was asked to stop (so that all stop at the same update).
+bool pool_progress(GradSync& sync, TrainStats& stats, EpisodeTally& tally, bool stop) {
   const bool none = stats.episodes == 0;
   std::vector<double> sums = {static_cast<double>(stats.episodes),
                               none ? 0 : stats.episodes * stats.episodic_return,
                               none ? 0 : stats.episodes * stats.episodic_length,
-                              score_sum,
-                              static_cast<double>(score_count),
-                              static_cast<double>(successes),
-                              static_cast<double>(ended),
+                              tally.score_sum,
+                              tally.scored,
+                              tally.successes,
+                              tally.ended,
                               stop ? 1.0 : 0.0};
   sync.all_reduce_sum(sums);
   stats.episodes = static_cast<int>(sums[0]);
   stats.episodic_return = sums[0] > 0 ? sums[1] / sums[0] : std::nan("");
   stats.episodic_length = sums[0] > 0 ? sums[2] / sums[0] : std::nan("");
-  score_sum = sums[3];
-  score_count = static_cast<int>(sums[4]);
-  successes = static_cast<long>(sums[5]);
-  ended = static_cast<long>(sums[6]);
+  tally = {sums[3], sums[4], sums[5], sums[6]};
   return sums[7] > 0;
 }
 
-}  // namespace
-
-namespace {
-// Whether a progress.csv holds a row past its header (a run that failed before its first report
-// leaves the header only).
-bool has_rows(const fs::path& csv) {
-  std::ifstream in(csv);
+// What a run left in `dir` (its latest checkpoint, or its progress rows); empty when none.
+fs::path held_run(const fs::path& dir) {
+  std::error_code ec;
+  if (fs::exists(dir / "checkpoints" / "latest.ckpt", ec))
+    return dir / "checkpoints" / "latest.ckpt";
+  // A run that failed before its first report leaves progress.csv's header only.
+  std::ifstream in(dir / "logs" / "progress.csv");
   std::string line;
-  return std::getline(in, line) && std::getline(in, line) && !line.empty();
+  if (std::getline(in, line) && std::getline(in, line) && !line.empty())
+    return dir / "logs" / "progress.csv";
+  return {};
 }
 }  // namespace
-
-std::string registered_env_id(const std::string& name) {
-  // `cradle illustrate`'s short names of the MIMo sample tasks.
-  for (const char* short_name : {"reach", "standup", "selfbody", "catch"})
-    if (name == short_name) return "mimo/" + name;
-  return envs::env_spec(name).id;  // UserError naming the closest ids
-}
-
-std::optional<Config> babybench_config(const std::string& name) {
-  const envs::EnvSpec spec = envs::env_spec(registered_env_id(name));
-  if (spec.family != "babybench") return std::nullopt;
-  return spec.config.empty() ? default_config() : load_config(spec.config);
-}
 
 namespace {
 
@@ -209,12 +169,10 @@ struct Run {
   // make_vector
   TrainingVector training;
   std::unique_ptr<intrinsic::Composite> reward;
-  // make_learner: the behaviour scores of the episodes ended since the last progress row, and
-  // (envs whose info has "is_success", the info's slot; -1: none) their successes.
-  double score_sum = 0;
-  int score_count = 0;
+  // make_learner: the episodes ended since the last progress row, and the info's slot of
+  // "is_success" (-1: the env has none).
+  EpisodeTally tally;
   int success_slot = -1;
-  long successes = 0, ended = 0;
   std::unique_ptr<Learner> learner;
   // A run that resets its learner: the run's steps before the current learner's, and how many
   // fresh learners it has made.
@@ -242,6 +200,8 @@ void check_options(Run& run) {
   if (options.envs < 1) throw UserError("--envs must be at least 1");
   if (options.checkpoint_every < 1) throw UserError("--checkpoint-every must be at least 1");
   if (options.reset_every < 0) throw UserError("--reset-every must be >= 0 (0: never)");
+  if (options.resume && options.overwrite)
+    throw UserError("--resume and --overwrite: give one of them");
   if (options.experiment && options.experiment->evaluate_every() < 1)
     throw UserError("the run's evaluations need at least 1 env step between them");
   // Worker processes: each holds the same number of envs; their envs' teacher and batches would
@@ -365,10 +325,11 @@ void check_options(Run& run) {
     run.curriculum = make_controller(*run.curriculum_spec, options.seed + run.rank);
   if (options.procs != 0 && run.curriculum_spec)
     throw UserError("--procs is not available with a curriculum (--task-space or --teacher)");
+  // Data-parallel: every rank must run the same command, or the collectives would not pair up.
   if (run.sync) {
     std::string hp_text;
     for (const auto& [name, value] : run.hyperparameters) hp_text += name + "=" + value + ";";
-    check_same_command(
+    const std::string differs = first_disagreement(
         *run.sync,
         {{"--envs", options.envs},
          {"--steps", static_cast<double>(options.steps)},
@@ -380,6 +341,10 @@ void check_options(Run& run) {
          {"--hp", static_cast<double>(std::hash<std::string>{}(hp_text) % (1L << 40))},
          {"--resume", options.resume ? 1.0 : 0.0},
          {"the checkpoint's step", static_cast<double>(run.resumed.steps)}});
+    if (!differs.empty()) {
+      throw UserError("the ranks run different commands (" + differs +
+                      " differs): start every rank with the same arguments");
+    }
   }
 }
 
@@ -397,11 +362,10 @@ void open_run_folder(Run& run) {
   const TrainOptions& options = run.options;
   if (!options.resume) {
     std::error_code ec;
-    // What a run leaves: its checkpoint, progress rows, an experiment's files.
-    fs::path held;
-    if (fs::exists(run.latest, ec)) held = run.latest;
-    if (held.empty() && has_rows(run.dir / "logs" / "progress.csv"))
-      held = run.dir / "logs" / "progress.csv";
+    // What a run leaves: its checkpoint, progress rows, an experiment's files; beside a run by id,
+    // its evaluations (evaluation.json, `cradle evaluate --run`'s evaluation_<checkpoint>.json,
+    // videos/) and the files of its family's tools (SaMI's evaluations), by name prefix.
+    fs::path held = held_run(run.dir);
     std::vector<std::string> removed = {"checkpoints", "logs", "plots", "ranks"};
     if (options.experiment) {
       for (const std::string& file : options.experiment->files()) {
@@ -409,10 +373,21 @@ void open_run_folder(Run& run) {
         removed.push_back(file);
       }
     }
+    if (run.by_id) {
+      std::vector<std::string> prefixes = family(envs::env_spec(run.env_id).family).outputs;
+      prefixes.insert(prefixes.end(), {"evaluation", "videos"});
+      for (const auto& entry : fs::directory_iterator(run.dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (std::ranges::any_of(prefixes, [&](const auto& p) { return name.starts_with(p); })) {
+          if (held.empty()) held = entry.path();
+          removed.push_back(name);
+        }
+      }
+    }
     if (!held.empty() && !options.overwrite) {
       throw UserError("'" + run.dir.string() + "' holds a run (" + held.string() +
                       "): give --resume to continue it, --overwrite to replace it, or another "
-                      "--save-dir");
+                      "folder");
     }
     if (!held.empty() && run.rank == 0) {
       for (const std::string& sub : removed) {
@@ -539,12 +514,12 @@ std::unique_ptr<Learner> fresh_learner(Run& run) {
       if (env.terminated()[i] || env.truncated()[i]) {
         const double s = env.env(i).score();
         if (!std::isnan(s)) {
-          run.score_sum += s;
-          ++run.score_count;
+          run.tally.score_sum += s;
+          ++run.tally.scored;
         }
         if (run.success_slot >= 0) {
-          run.successes += env.info(i).flag(run.success_slot);
-          ++run.ended;
+          run.tally.successes += env.info(i).flag(run.success_slot);
+          ++run.tally.ended;
         }
       }
     }
@@ -685,6 +660,27 @@ void save_checkpoint(Run& run, const std::vector<fs::path>& files) {
   }
 }
 
+// One row of logs/progress.csv (rank 0 writes them): the run's columns, the learner's report
+// keys, the experiment's columns.
+void write_progress_row(Run& run, const TrainStats& s, double elapsed, double score,
+                        double success_rate) {
+  std::vector<double> row = {
+      static_cast<double>(s.steps), elapsed, s.sps, s.episodic_return, s.episodic_length, score};
+  if (run.success_slot >= 0) row.push_back(success_rate);
+  // A report column's key is its name after the group ("losses/alpha": alpha).
+  for (const std::string column : kReportColumns)
+    row.push_back(loss(s, column.substr(column.find('/') + 1)));
+  for (const std::string& key : run.extra) row.push_back(loss(s, key));
+  if (run.options.experiment) {
+    for (double value : run.options.experiment->progress_values()) row.push_back(value);
+  }
+  for (size_t c = 0; c < row.size(); ++c) run.csv << (c ? "," : "") << csv_cell(row[c]);
+  run.csv << "\n";
+  run.csv.flush();
+  if (!run.csv) throw UserError("cannot write '" + run.csv_file.string() + "'");
+  run.rows.push_back(std::move(row));
+}
+
 // What an experiment's hooks see of the run now.
 RunView view(const Run& run) {
   double teacher_seconds = 0;
@@ -755,47 +751,20 @@ long train_loop(Run& run, TrainResult& result) {
     TrainStats s = local;
     s.steps += run.offset;
     if (run.sync) {
-      stopped = pool_progress(*run.sync, s, run.score_sum, run.score_count, run.successes,
-                              run.ended, options.stop && options.stop->load());
+      stopped = pool_progress(*run.sync, s, run.tally, options.stop && options.stop->load());
     }
     check_finite_losses(s, run.latest);
     write_teacher_log(run);
     if (run.reward) run.reward->update();
     if (experiment && run.rank == 0) experiment->report(s);
     const double elapsed = std::chrono::duration<double>(Clock::now() - run.start).count();
-    if (run.score_count > 0) last_score = run.score_sum / run.score_count;
-    const double window_score =
-        run.score_count > 0 ? run.score_sum / run.score_count : std::nan("");
-    const double success_rate =
-        run.ended > 0 ? static_cast<double>(run.successes) / run.ended : std::nan("");
-    if (run.ended > 0) last_success = success_rate;
-    run.score_sum = 0;
-    run.score_count = 0;
-    run.successes = 0;
-    run.ended = 0;
-    std::vector<double> row = {static_cast<double>(s.steps),
-                               elapsed,
-                               s.sps,
-                               s.episodic_return,
-                               s.episodic_length,
-                               window_score};
-    if (run.success_slot >= 0) row.push_back(success_rate);
-    // A report column's key is its name after the group ("losses/alpha": alpha).
-    for (const std::string column : kReportColumns)
-      row.push_back(loss(s, column.substr(column.find('/') + 1)));
-    for (const std::string& key : run.extra) row.push_back(loss(s, key));
-    // An experiment's columns (its hooks are rank 0's; the other ranks write no row).
-    if (experiment) {
-      const std::vector<double> values =
-          run.rank == 0 ? experiment->progress_values()
-                        : std::vector<double>(experiment->progress_columns().size(), std::nan(""));
-      row.insert(row.end(), values.begin(), values.end());
-    }
-    for (size_t c = 0; c < row.size(); ++c) run.csv << (c ? "," : "") << csv_cell(row[c]);
-    run.csv << "\n";
-    run.csv.flush();
-    if (run.rank == 0 && !run.csv) throw UserError("cannot write '" + run.csv_file.string() + "'");
-    run.rows.push_back(std::move(row));
+    const EpisodeTally& t = run.tally;
+    const double window_score = t.scored > 0 ? t.score_sum / t.scored : std::nan("");
+    const double success_rate = t.ended > 0 ? t.successes / t.ended : std::nan("");
+    if (t.scored > 0) last_score = window_score;
+    if (t.ended > 0) last_success = success_rate;
+    run.tally = {};
+    if (run.rank == 0) write_progress_row(run, s, elapsed, window_score, success_rate);
     if (options.on_report) options.on_report(s);
     if (in_reports && s.steps >= next_checkpoint && s.steps < options.steps) {
       save_step_checkpoint(run);
@@ -859,9 +828,10 @@ void finish(Run& run, long next_checkpoint, TrainResult& result) {
   result.parameter_hash = run.learner->parameter_hash();
   // Data-parallel: every rank must end with the same networks.
   const std::uint64_t hash = result.parameter_hash;
-  if (run.sync && !first_difference(*run.sync, {{"high", static_cast<double>(hash >> 32)},
-                                                {"low", static_cast<double>(hash & 0xffffffffULL)}})
-                       .empty()) {
+  if (run.sync &&
+      !first_disagreement(*run.sync, {{"high", static_cast<double>(hash >> 32)},
+                                      {"low", static_cast<double>(hash & 0xffffffffULL)}})
+           .empty()) {
     throw UserError(
         "the ranks' parameters differ after training (a learner broke the "
         "data-parallel contract)");
@@ -933,37 +903,6 @@ TrainResult train(const Config& config, const TrainOptions& options) {
   const long next_checkpoint = train_loop(run, result);
   finish(run, next_checkpoint, result);
   return result;
-}
-
-CheckpointLearner load_learner(const std::filesystem::path& checkpoint, const std::string& env_id,
-                               const envs::EnvOptions& options,
-                               const std::map<std::string, std::string>& overrides,
-                               std::uint64_t seed) {
-  const CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
-  std::map<std::string, std::string> hyperparameters = parse_hyperparameter_text(info.config);
-  for (const auto& [name, value] : overrides) hyperparameters[name] = value;
-  CheckpointLearner out;
-  out.vec = make_env_training(env_id, 1, 1, seed, nullptr, 0, options).vec;
-  out.learner = learn::make_learner(info.algorithm, *out.vec,
-                                    {.seed = seed, .hyperparameters = hyperparameters});
-  out.learner->load(checkpoint);
-  return out;
-}
-
-train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,
-                          bool sampled) {
-  if (!fs::exists(checkpoint)) {
-    throw UserError("policy checkpoint '" + checkpoint.string() + "' does not exist");
-  }
-  const CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
-  // A one-env vector of the config gives the learner its spaces; it is kept alive by the policy.
-  std::shared_ptr<VecEnv> vec = make_babybench_vec_env(config, 1, 1, /*training=*/false, 0);
-  LearnerOptions lo{.hyperparameters = learn::parse_hyperparameter_text(info.config)};
-  std::shared_ptr<Learner> learner = learn::make_learner(info.algorithm, *vec, lo);
-  learner->load(checkpoint);
-  return [vec, learner, sampled](const envs::BabyBenchEnv& env, std::span<double> action) {
-    learner->act(env.observation(), action, /*deterministic=*/!sampled);
-  };
 }
 
 }  // namespace cradle::train

@@ -133,33 +133,7 @@ struct TrainResult {
   std::uint64_t parameter_hash = 0;  // Learner::parameter_hash of the trained networks
 };
 
-// The registered id of an env name: an id, an alias or a MIMo sample task's short name. UserError
-// naming the closest ids for an unknown one.
-std::string registered_env_id(const std::string& name);
-
-// The config a BabyBench id trains as (the registry's file, or the documented defaults); nullopt
-// for an id of another family. UserError naming the closest ids for an unknown one.
-std::optional<Config> babybench_config(const std::string& name);
-
 // With options.env set, only config.save_dir is read.
 TrainResult train(const Config& config, const TrainOptions& options);
-
-// A checkpoint's learner on a one-env vector of an env id (kept with it, the learner acts on it),
-// e.g. to test a trained policy on an env of its own: the checkpoint's hyperparameters with
-// `overrides` over them, seeded `seed` (a checkpoint that restores its generator overrides it).
-struct CheckpointLearner {
-  std::shared_ptr<learn::VecEnv> vec;
-  std::shared_ptr<learn::Learner> learner;
-};
-CheckpointLearner load_learner(const std::filesystem::path& checkpoint, const std::string& env_id,
-                               const envs::EnvOptions& options = {},
-                               const std::map<std::string, std::string>& overrides = {},
-                               std::uint64_t seed = 0);
-
-// The policy of a checkpoint, for `cradle evaluate --policy`: the mean action, or with `sampled`
-// actions drawn from the policy's distribution (as SB3's predict() does by default) by the
-// checkpoint's own generator, so a sampled evaluation of one checkpoint repeats exactly.
-train::Policy load_policy(const Config& config, const std::filesystem::path& checkpoint,
-                          bool sampled = false);
 
 }  // namespace cradle::train

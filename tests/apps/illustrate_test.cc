@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fixture.h"
+#include "learn/registry.h"
 
 namespace {
 
@@ -45,6 +46,10 @@ TEST(Illustrate, BadFlagsAreOneLineErrors) {
   }
   EXPECT_NE(cradle_in(dir, "illustrate --env reach --algorithm HER").out.find("not supported"),
             std::string::npos);
+  // The algorithms are the learner registry's, named in any case.
+  const std::string unknown = cradle_in(dir, "illustrate --env reach --algorithm XYZ").out;
+  EXPECT_NE(unknown.find(cradle::learn::algorithm_list()), std::string::npos) << unknown;
+  EXPECT_EQ(cradle_in(dir, "illustrate --env reach --algorithm SaCCM --test_for 0").status, 0);
 }
 
 TEST(Illustrate, TrainsSavesTestsFilmsAndReloads) {

@@ -243,9 +243,25 @@ TEST(TrainEnv, AFinishedRunIsNeverReplacedSilently) {
     EXPECT_NE(again.out.find("--resume"), std::string::npos) << again.out;
     EXPECT_NE(again.out.find("--overwrite"), std::string::npos) << again.out;
     EXPECT_EQ(read_lines(dir / "run" / "logs" / "progress.csv"), before);
+    // Continuing and replacing at once is refused too.
+    const RunResult both = run_cradle(args + " --resume --overwrite", dir);
+    EXPECT_EQ(both.status, 1) << both.out;
+    EXPECT_EQ(std::count(both.out.begin(), both.out.end(), '\n'), 1) << both.out;
+    EXPECT_EQ(read_lines(dir / "run" / "logs" / "progress.csv"), before);
+    // `cradle evaluate --run`'s files measured this run: --overwrite removes them with it.
+    std::ofstream(dir / "run" / "evaluation_final.json") << "{}\n";
+    fs::create_directories(dir / "run" / "videos");
     const RunResult replaced = run_cradle(args + " --seed 9 --overwrite", dir);
     EXPECT_EQ(replaced.status, 0) << replaced.out;
     EXPECT_NE(read_lines(dir / "run" / "logs" / "progress.csv"), before);
+    EXPECT_FALSE(fs::exists(dir / "run" / "evaluation_final.json"));
+    EXPECT_FALSE(fs::exists(dir / "run" / "videos"));
+    // A folder whose only trace of a run is its evaluation is still refused, naming the file.
+    fs::remove_all(dir / "run" / "checkpoints");
+    fs::remove_all(dir / "run" / "logs");
+    const RunResult evaluated = run_cradle(args, dir);
+    EXPECT_EQ(evaluated.status, 1) << evaluated.out;
+    EXPECT_NE(evaluated.out.find("evaluation.json"), std::string::npos) << evaluated.out;
     fs::remove_all(dir / "run");
   }
 }

@@ -25,6 +25,11 @@ def test_a_python_run_is_the_cli_run(tmp_path):
                 seed=3, hyperparameters=TINY, out=str(py_run), motors_torque=80)
     assert r["run"] == str(py_run)
     assert r["env_steps"] == 1000 and r["evaluations"] == 3  # at 0, 500 and 1000 steps
+    # The result is summary.json's record, and the run folder.
+    summary = json.loads((py_run / "summary.json").read_text())
+    assert list(r) == list(summary) + ["run"]
+    assert {k: r[k] for k in ("env_steps", "episodes", "evaluations", "pct_mastered")} == \
+        {k: summary[k] for k in ("env_steps", "episodes", "evaluations", "pct_mastered")}
     cli_run = tmp_path / "cli"
     subprocess.run([cradle_binary(), "tma", "run", "--student", "sac", "--teacher", "Random", "--steps",
                     "1000", "--test_every", "500", "--nb_test_episodes", "2", "--seed", "3",

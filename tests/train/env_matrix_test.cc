@@ -19,6 +19,7 @@
 #include "fixture.h"
 #include "learn/learner.h"
 #include "learn/vector_env.h"
+#include "train/env_vector.h"
 #include "train/trainer.h"
 
 namespace cradle::test {

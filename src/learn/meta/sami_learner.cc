@@ -22,6 +22,7 @@
 #include "learn/checkpoint.h"
 #include "learn/grad_tensors.h"
 #include "learn/meta/context_sac.h"
+#include "learn/meta/methods.h"
 #include "learn/meta/samplers.h"
 #include "learn/meta/trajectory_replay.h"
 #include "learn/networks.h"
@@ -436,6 +437,13 @@ TrainStats SamiLearner::report(Clock::time_point start, long start_steps) {
 
 std::span<const std::string_view> sami_learner_names() { return kNames; }
 
+std::string sami_learner_list() {
+  std::string out;
+  for (size_t k = 0; k < kNames.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == kNames.size() ? " or " : ", ") + std::string(kNames[k]);
+  return out;
+}
+
 std::string_view sami_method(std::string_view algorithm) {
   for (size_t k = 0; k < kNames.size(); ++k) {
     if (kNames[k] == algorithm) return kMethods[k];
@@ -443,12 +451,20 @@ std::string_view sami_method(std::string_view algorithm) {
   return {};
 }
 
+std::string sami_learner_name(std::string_view method) {
+  for (size_t k = 0; k < kNames.size(); ++k) {
+    if (kMethods[k] == method) return std::string(kNames[k]);
+  }
+  method_contrast(method);  // the one-line error naming the methods
+  throw UserError("unknown SaMI method '" + std::string(method) + "'");
+}
+
 std::span<const float> last_context(const Learner& learner) {
   const auto* sami = dynamic_cast<const SamiLearner*>(&learner);
   if (sami == nullptr) {
     throw UserError(std::string(learner.algorithm()) +
-                    " infers no context (expected one of SaMI's learners: tesac, ccm, satesac, "
-                    "saccm or saccm_all)");
+                    " infers no context (expected one of SaMI's learners: " + sami_learner_list() +
+                    ")");
   }
   return sami->context();
 }
@@ -457,8 +473,8 @@ std::unique_ptr<Learner> make_sami_learner(std::string_view algorithm, VecEnv& e
                                            const LearnerOptions& options) {
   const std::string_view method = sami_method(algorithm);
   if (method.empty()) {
-    throw UserError("unknown SaMI learner '" + std::string(algorithm) +
-                    "' (expected tesac, ccm, satesac, saccm or saccm_all)");
+    throw UserError("unknown SaMI learner '" + std::string(algorithm) + "' (expected " +
+                    sami_learner_list() + ")");
   }
   const std::string name(algorithm);
   return std::make_unique<SamiLearner>(name, std::string(method), env, options,

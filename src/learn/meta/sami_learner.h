@@ -75,8 +75,12 @@ struct SamiLearnerConfig {
 
 // "tesac", "ccm", "satesac", "saccm", "saccm_all", in this order.
 std::span<const std::string_view> sami_learner_names();
+// The same for messages: "tesac, ccm, satesac, saccm or saccm_all".
+std::string sami_learner_list();
 // ContextSac's method of a learner name ("saccm" -> "SaCCM"); "" for another name.
 std::string_view sami_method(std::string_view algorithm);
+// The learner name of a method ("SaCCM" -> "saccm"); UserError naming the methods for another.
+std::string sami_learner_name(std::string_view method);
 
 // Throws UserError for an unknown algorithm or hyperparameter, a bad value, an env with uint8
 // (image) observation keys or no float ones, an action space without finite bounds, CCM on fewer

@@ -8,23 +8,19 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <numeric>
 #include <sstream>
 
 #include "core/error.h"
 #include "core/sealed_file.h"
 #include "envs/sami/sami_env.h"
 #include "eval/video.h"
-#include "learn/checkpoint.h"
-#include "learn/hyperparams.h"
 #include "learn/meta/sami_learner.h"
-#include "learn/registry.h"
 #include "sami/env.h"
 #include "sami/render.h"
 #include "sami/task.h"
-#include "train/env_vector.h"
 #include "train/episodes.h"
 #include "train/loop.h"
+#include "train/run_policy.h"
 #include "train/sami/sami_experiment.h"
 
 namespace cradle::train {
@@ -61,27 +57,8 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   if (options.episodes < 1) throw UserError("sami evaluate: --episodes must be positive");
   const sami::Spec spec = sami::env_spec(id);
   const bool panda = id == sami::EnvId::kPandaPush;
-  // The trained learner, on a vector of the run's training envs (its spaces and replay shape).
-  const fs::path checkpoint = options.run / "checkpoints" / "latest.ckpt";
-  std::error_code ec;
-  if (!fs::exists(checkpoint, ec)) {
-    throw UserError("sami evaluate: no checkpoint at '" + checkpoint.string() +
-                    "' (train the run first: cradle sami train --out " + options.run.string() +
-                    ")");
-  }
-  const learn::CheckpointInfo info = learn::read_checkpoint_info(checkpoint);
-  const std::map<std::string, std::string> settings = learn::parse_hyperparameter_text(info.config);
-  const auto context_setting = settings.find("context_size");
-  if (info.algorithm != saved.algorithm || context_setting == settings.end()) {
-    throw UserError("sami evaluate: " + checkpoint.string() + " is not the " + saved.algorithm +
-                    " checkpoint its run.json names");
-  }
-  const int context_size = std::stoi(context_setting->second);
-  std::unique_ptr<learn::VecEnv> vec =
-      make_env_training(saved.env_id, static_cast<int>(saved.envs), 1, 0, {}, 0).vec;
-  std::unique_ptr<learn::Learner> learner =
-      learn::make_learner(info.algorithm, *vec, {.hyperparameters = settings});
-  learner->load(checkpoint);
+  // The run's latest checkpoint, acting deterministically (its learner's contexts recorded).
+  const RunPolicy policy = load_run_policy(options.run, "latest");
   torch::set_num_threads(1);
 
   SamiEvalResult result{.split = options.split, .skills = panda};
@@ -89,10 +66,6 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   result.json = options.run / (stem + ".json");
   result.csv = options.run / (stem + ".csv");
   result.contexts = options.run / ("contexts_" + options.split + ".csv");
-  std::ofstream contexts(result.contexts);
-  contexts << "task_set,cell,episode,step,mass,damping,crippled,skill,episode_skill";
-  for (int k = 0; k < context_size; ++k) contexts << ",c" << k;
-  contexts << ",pc1,pc2\n";
   std::vector<std::string> context_rows, episode_rows;
   std::vector<float> context_values;
   std::unique_ptr<eval::VideoWriter> video;
@@ -120,14 +93,10 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
     // every step: the context the learner acted with and the step's task and skill (every
     // context_every-th step), the first episode's frame; at the episode's end its skill labels
     // the rows and counts in the cell's mix.
-    learn::Learner* l = learner.get();
     std::string episode_task;
     const std::vector<EpisodeOutcome> episodes = run_episodes(
-        adapter,
-        {.act = [l](const envs::ObservationBuffers& obs,
-                    std::span<double> a) { l->act(obs, a, /*deterministic=*/true); },
-         .new_episode = [l] { l->new_episode(); }},
-        options.episodes, 0, [&](int e, const envs::Env&, const envs::StepResult& r) {
+        adapter, policy.episode_policy(), options.episodes, 0,
+        [&](int e, const envs::Env&, const envs::StepResult& r) {
           const sami::Info& info = env.info();
           const int step = info.steps - 1;
           // The parameters this episode drew (the task, within its task set): mass, damping, the
@@ -137,7 +106,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
                            (info.crippled.empty() ? "none" : sami::joints_text(info.crippled, "+"));
           }
           if (step % context_every == 0) {
-            const std::span<const float> c = learn::meta::last_context(*l);
+            const std::span<const float> c = learn::meta::last_context(policy.learner());
             episode_rows.push_back(std::to_string(s) + ",\"" + cell.name + "\"," +
                                    std::to_string(e) + "," + std::to_string(step) + "," +
                                    episode_task + "," + std::string(sami::skill_name(info.skill)));
@@ -156,21 +125,20 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
           cell.roll += info.episode_skill == sami::Skill::kRoll;
           cell.pick_and_place += info.episode_skill == sami::Skill::kPickAndPlace;
         });
-    std::vector<double> episode_returns;
-    for (const EpisodeOutcome& o : episodes) episode_returns.push_back(o.episode_return);
+    // The cell's shares and return statistics over its episodes, and the split's totals.
     cell.episodes = options.episodes;
     const double k = options.episodes;
     all_success += cell.success_rate;
     all_episodes += options.episodes;
-    cell.success_rate /= k;
-    cell.push /= k;
-    cell.roll /= k;
-    cell.pick_and_place /= k;
-    cell.mean_return = std::accumulate(episode_returns.begin(), episode_returns.end(), 0.0) / k;
+    for (double* share : {&cell.success_rate, &cell.push, &cell.roll, &cell.pick_and_place})
+      *share /= k;
+    for (const EpisodeOutcome& o : episodes) cell.mean_return += o.episode_return;
+    cell.mean_return /= k;
     all_return += cell.mean_return * k;
-    double var = 0;
-    for (double v : episode_returns) var += (v - cell.mean_return) * (v - cell.mean_return);
-    cell.std_return = std::sqrt(var / k);
+    for (const EpisodeOutcome& o : episodes)
+      cell.std_return +=
+          (o.episode_return - cell.mean_return) * (o.episode_return - cell.mean_return);
+    cell.std_return = std::sqrt(cell.std_return / k);
     result.cells.push_back(cell);
   }
   if (video) video->close();
@@ -180,6 +148,11 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   // Context pictures: the 2-D PCA of every recorded context (centred, top two right singular
   // vectors).
   const long rows = static_cast<long>(context_rows.size());
+  const long context_size = rows > 0 ? static_cast<long>(context_values.size()) / rows : 0;
+  std::ofstream contexts(result.contexts);
+  contexts << "task_set,cell,episode,step,mass,damping,crippled,skill,episode_skill";
+  for (long k = 0; k < context_size; ++k) contexts << ",c" << k;
+  contexts << ",pc1,pc2\n";
   torch::Tensor pcs = torch::zeros({rows, 2});
   if (rows > 1) {
     const torch::Tensor x =
@@ -194,7 +167,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   const torch::Tensor pc = pcs.to(torch::kFloat64).contiguous();
   for (long r = 0; r < rows; ++r) {
     contexts << context_rows[r];
-    for (int k = 0; k < context_size; ++k) {
+    for (long k = 0; k < context_size; ++k) {
       contexts << "," << csv_cell(context_values[r * context_size + k]);
     }
     contexts << "," << csv_cell(pc[r][0].item<double>()) << "," << csv_cell(pc[r][1].item<double>())

@@ -12,7 +12,6 @@
 #include "core/error.h"
 #include "envs/registry.h"
 #include "learn/hyperparams.h"
-#include "learn/meta/methods.h"
 #include "learn/meta/sami_learner.h"
 #include "learn/registry.h"
 #include "sami/env.h"
@@ -24,47 +23,23 @@
 
 namespace cradle::train {
 namespace {
-
 namespace fs = std::filesystem;
-
-// The learner registry's name of a SaMI method ("SaCCM" -> "saccm"); UserError for another.
-std::string learner_name(const std::string& method) {
-  for (const std::string_view name : learn::meta::sami_learner_names()) {
-    if (learn::meta::sami_method(name) == method) return std::string(name);
-  }
-  learn::meta::method_contrast(method);  // the one-line error naming the methods
-  throw UserError("unknown SaMI method '" + method + "'");
-}
-
-// Whether `run` holds a run: a checkpoint (this layout's or an earlier one's) or progress rows.
-fs::path held_run(const fs::path& run) {
-  std::error_code ec;
-  for (const fs::path& file : {run / "checkpoints" / "latest.ckpt", run / "checkpoint.ckpt"}) {
-    if (fs::exists(file, ec)) return file;
-  }
-  std::ifstream in(run / "logs" / "progress.csv");
-  std::string line;
-  if (std::getline(in, line) && std::getline(in, line) && !line.empty())
-    return run / "logs" / "progress.csv";
-  return {};
-}
-
 }  // namespace
 
 std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id) {
   return sami::one_set_per_env(sami::split_sets(id, sami::Split::kTrain));
 }
 
-std::map<std::string, std::string> sami_presets(const std::string& env_id, int max_episode_steps,
+std::map<std::string, std::string> sami_presets(const envs::EnvSpec& env,
                                                 const std::string& algorithm) {
   if (learn::meta::sami_method(algorithm).empty()) return {};
   std::map<std::string, std::string> presets;
-  if (max_episode_steps > 0) {
-    presets["horizon"] = std::to_string(max_episode_steps);
-    presets["report_every"] = std::to_string(max_episode_steps);
+  if (env.max_episode_steps > 0) {
+    presets["horizon"] = std::to_string(env.max_episode_steps);
+    presets["report_every"] = std::to_string(env.max_episode_steps);
   }
   // Panda's config (tma_sami.md §6).
-  if (env_id.starts_with("sami/PandaPush:")) {
+  if (env.id.starts_with("sami/PandaPush:")) {
     presets["buffer_size"] = "1000";
     presets["batch_size"] = "256";
     presets["contrast_batch_size"] = "256";
@@ -93,8 +68,8 @@ SamiRunFile read_sami_run(const fs::path& run) {
   r.method = std::string(learn::meta::sami_method(r.algorithm));
   if (r.method.empty()) {
     throw UserError(j.where() + ": algorithm '" + r.algorithm +
-                    "' is not one of SaMI's learners (expected tesac, ccm, satesac, saccm or "
-                    "saccm_all)");
+                    "' is not one of SaMI's learners (expected " +
+                    learn::meta::sami_learner_list() + ")");
   }
   r.env = envs::split_env_id(r.env_id).name;
   try {
@@ -107,7 +82,9 @@ SamiRunFile read_sami_run(const fs::path& run) {
 }
 
 SamiTrainResult sami_train(const SamiTrainOptions& options) {
-  // The run's settings: fresh from the options, or on --resume from run.json.
+  // The run's settings: fresh from the options, or on --resume from run.json. A folder that holds
+  // a run is refused without --resume or --overwrite, which clears it (the run's rule; SaMI's
+  // evaluations and an earlier version's files are the family's outputs, train/families.h).
   if (options.out.empty() && (options.env.empty() || options.method.empty())) {
     throw UserError("sami train: give the run folder (--out) or the env and the method");
   }
@@ -120,8 +97,6 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
   std::string env_name = options.env, method = options.method;
   std::uint64_t seed = options.seed;
   long steps_per_env = options.steps_per_env;
-  // What the folder holds already (a fresh run refuses it without --overwrite, which clears it).
-  const fs::path held = options.resume ? fs::path() : held_run(run);
   if (options.resume) {
     const SamiRunFile saved = read_sami_run(run);
     // A resumed run keeps its env and method: one given that contradicts them is refused, not
@@ -149,13 +124,10 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
     method = saved.method;
     seed = saved.seed;
     if (steps_per_env == 0) steps_per_env = saved.steps_per_env;
-  } else if (!held.empty() && !options.overwrite) {
-    throw UserError("sami train: " + run.string() + " already holds a run (" + held.string() +
-                    "): pass --resume to continue it, --overwrite to replace it, or another --out");
   }
   if (options.steps < 0) throw UserError("sami train: --steps must be positive");
   const sami::EnvId id = sami::env_from_name(env_name);
-  const std::string algorithm = learner_name(method);
+  const std::string algorithm = learn::meta::sami_learner_name(method);
   const long envs = static_cast<long>(sami_training_sets(id).size());
   if (options.steps > 0) steps_per_env = (options.steps + envs - 1) / envs;
   if (steps_per_env == 0) steps_per_env = id == sami::EnvId::kPandaPush ? 1'000'000 : 500'000;
@@ -166,22 +138,9 @@ SamiTrainResult sami_train(const SamiTrainOptions& options) {
 
   // SaMI's settings come with `cradle train`'s presets for its learners (sami_presets); a
   // resumed run keeps its checkpoint's. The user's go over them.
-  std::map<std::string, std::string> hp;
-  if (options.report_every > 0) hp["report_every"] = std::to_string(options.report_every);
-  for (const auto& [k, v] : options.hyperparameters) hp[k] = v;
-
-  // An overwritten run's evaluations go with it (`cradle train` removes its logs and
-  // checkpoints, and an earlier layout's files go here).
-  if (options.overwrite && !held.empty()) {
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(run, ec)) {
-      const std::string name = entry.path().filename().string();
-      if (name.starts_with("checkpoint.ckpt") || name.starts_with("progress.") ||
-          name.starts_with("eval_") || name.starts_with("contexts_")) {
-        fs::remove_all(entry.path(), ec);
-      }
-    }
-  }
+  std::map<std::string, std::string> hp = options.hyperparameters;
+  if (options.report_every > 0)
+    hp.try_emplace("report_every", std::to_string(options.report_every));
 
   Config config;
   config.save_dir = run.string();

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "envs/registry.h"
 #include "learn/grad_sync.h"
 #include "sami/task.h"
 
@@ -34,7 +35,7 @@ std::vector<sami::TaskSet> sami_training_sets(sami::EnvId id);
 // train` applies under the user's --hp values: trajectories and progress rows as long as the
 // env's episodes (`horizon`, `report_every`; SaMI stores whole episodes), and on Panda push its
 // replay and batch sizes (1000 trajectories, batches of 256). Empty for another algorithm.
-std::map<std::string, std::string> sami_presets(const std::string& env_id, int max_episode_steps,
+std::map<std::string, std::string> sami_presets(const envs::EnvSpec& env,
                                                 const std::string& algorithm);
 
 struct SamiTrainOptions {

@@ -1,8 +1,6 @@
 // SaMI's train / evaluate / table: a few-hundred-step run of every method on Panda push and on a
 // crippled locomotion env, the same run as `cradle train`'s, resume, evaluation files and the
 // table.
-#include "train/sami/sami_experiment.h"
-
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -15,6 +13,7 @@
 #include "core/error.h"
 #include "learn/checkpoint.h"
 #include "learn/meta/samplers.h"
+#include "train/sami/sami_experiment.h"
 #include "train/trainer.h"
 
 namespace cradle::train {
@@ -147,6 +146,22 @@ TEST(SamiTrain, ResumeContinuesAndEvaluateWritesCells) {
   EXPECT_EQ(j.at("method"), "SaCCM");
   EXPECT_EQ(j.at("cells").size(), 8u);
   EXPECT_THROW(sami_evaluate({.run = dir, .split = "hard"}), UserError);
+  // The evaluations measured this run: a folder holding only them is refused, and --overwrite
+  // removes them with the run.
+  std::filesystem::remove_all(dir / "checkpoints");
+  std::filesystem::remove_all(dir / "logs");
+  o.resume = false;
+  o.steps_per_env = 25;
+  try {
+    sami_train(o);
+    ADD_FAILURE() << "a folder holding evaluations was not refused";
+  } catch (const UserError& error) {
+    EXPECT_NE(std::string(error.what()).find("holds a run"), std::string::npos) << error.what();
+  }
+  EXPECT_TRUE(std::filesystem::exists(e.json));
+  o.overwrite = true;
+  sami_train(o);
+  for (const auto& file : {e.json, e.csv, e.contexts}) EXPECT_FALSE(std::filesystem::exists(file));
   std::filesystem::remove_all(dir);
 }
 
