@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -149,7 +148,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
   // vectors).
   const long rows = static_cast<long>(context_rows.size());
   const long context_size = rows > 0 ? static_cast<long>(context_values.size()) / rows : 0;
-  std::ofstream contexts(result.contexts);
+  std::ostringstream contexts;
   contexts << "task_set,cell,episode,step,mass,damping,crippled,skill,episode_skill";
   for (long k = 0; k < context_size; ++k) contexts << ",c" << k;
   contexts << ",pc1,pc2\n";
@@ -173,6 +172,7 @@ SamiEvalResult sami_evaluate(const SamiEvalOptions& options) {
     contexts << "," << csv_cell(pc[r][0].item<double>()) << "," << csv_cell(pc[r][1].item<double>())
              << "\n";
   }
+  write_atomically(result.contexts, contexts.str());
 
   // Per-cell CSV and JSON.
   std::ostringstream table;
