@@ -50,7 +50,8 @@ const std::pair<std::string_view, Family> kFamilies[] = {
     {"sami",
      {.presets = sami_presets,
       .curriculum = declared_space,
-      .outputs = {"eval_", "contexts_", "checkpoint.ckpt", "progress."}}},
+      .outputs = {"eval_*.json", "eval_*.csv", "eval_*.mp4", "contexts_*.csv", "checkpoint.ckpt",
+                  "progress*.csv"}}},
 };
 
 }  // namespace

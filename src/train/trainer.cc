@@ -123,6 +123,14 @@ bool pool_progress(GradSync& sync, TrainStats& stats, EpisodeTally& tally, bool 
   return sums[7] > 0;
 }
 
+// Whether a file name is `pattern`, where one '*' stands for any text ("eval_*.json").
+bool name_matches(const std::string& name, const std::string& pattern) {
+  const size_t star = pattern.find('*');
+  if (star == std::string::npos) return name == pattern;
+  return name.size() + 1 >= pattern.size() && name.starts_with(pattern.substr(0, star)) &&
+         name.ends_with(pattern.substr(star + 1));
+}
+
 // What a run left in `dir` (its latest checkpoint, or its progress rows); empty when none.
 fs::path held_run(const fs::path& dir) {
   std::error_code ec;
@@ -364,7 +372,7 @@ void open_run_folder(Run& run) {
     std::error_code ec;
     // What a run leaves: its checkpoint, progress rows, an experiment's files; beside a run by id,
     // its evaluations (evaluation.json, `cradle evaluate --run`'s evaluation_<checkpoint>.json,
-    // videos/) and the files of its family's tools (SaMI's evaluations), by name prefix.
+    // videos/) and the files of its family's tools (SaMI's evaluations), by name.
     fs::path held = held_run(run.dir);
     std::vector<std::string> removed = {"checkpoints", "logs", "plots", "ranks"};
     if (options.experiment) {
@@ -374,11 +382,11 @@ void open_run_folder(Run& run) {
       }
     }
     if (run.by_id) {
-      std::vector<std::string> prefixes = family(envs::env_spec(run.env_id).family).outputs;
-      prefixes.insert(prefixes.end(), {"evaluation", "videos"});
+      std::vector<std::string> patterns = family(envs::env_spec(run.env_id).family).outputs;
+      patterns.insert(patterns.end(), {"evaluation*.json", "videos"});
       for (const auto& entry : fs::directory_iterator(run.dir, ec)) {
         const std::string name = entry.path().filename().string();
-        if (std::ranges::any_of(prefixes, [&](const auto& p) { return name.starts_with(p); })) {
+        if (std::ranges::any_of(patterns, [&](const auto& p) { return name_matches(name, p); })) {
           if (held.empty()) held = entry.path();
           removed.push_back(name);
         }

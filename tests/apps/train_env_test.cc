@@ -251,11 +251,13 @@ TEST(TrainEnv, AFinishedRunIsNeverReplacedSilently) {
     // `cradle evaluate --run`'s files measured this run: --overwrite removes them with it.
     std::ofstream(dir / "run" / "evaluation_final.json") << "{}\n";
     fs::create_directories(dir / "run" / "videos");
+    std::ofstream(dir / "run" / "evaluation_notes.txt") << "the user's own\n";  // not the run's
     const RunResult replaced = run_cradle(args + " --seed 9 --overwrite", dir);
     EXPECT_EQ(replaced.status, 0) << replaced.out;
     EXPECT_NE(read_lines(dir / "run" / "logs" / "progress.csv"), before);
     EXPECT_FALSE(fs::exists(dir / "run" / "evaluation_final.json"));
     EXPECT_FALSE(fs::exists(dir / "run" / "videos"));
+    EXPECT_TRUE(fs::exists(dir / "run" / "evaluation_notes.txt"));
     // A folder whose only trace of a run is its evaluation is still refused, naming the file.
     fs::remove_all(dir / "run" / "checkpoints");
     fs::remove_all(dir / "run" / "logs");
