@@ -35,7 +35,7 @@ def line_plot(ax, figure):
             ax.scatter(x, y, s=12, label=s.get("label") or None)
         else:
             # A line through fewer than two points draws nothing: mark the point instead.
-            lone = sum(1 for v in y if v == v) < 2
+            lone = sum(1 for v in y if not math.isnan(v)) < 2
             ax.plot(x, y, linewidth=1.5, marker="o" if lone else None,
                     label=s.get("label") or None)
     for y, label in figure.get("h_lines", []):

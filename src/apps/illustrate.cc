@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -272,11 +271,15 @@ void run(const IllustrateOptions& o) {
                 e.episode_return, e.success ? "success" : "no success");
     episodes.push_back(e);
   }
-  const nlohmann::ordered_json summary = train::episodes_json(episodes);
-  const double rate = summary["success_rate"], n = static_cast<double>(episodes.size());
-  std::printf("%zu test episodes: success rate %.1f %% (%ld/%zu), mean return %.3f\n",
-              episodes.size(), 100.0 * rate, std::lround(rate * n), episodes.size(),
-              summary["mean_return"].get<double>());
+  double returns = 0;
+  int successes = 0;
+  for (const train::EpisodeOutcome& e : episodes) {
+    returns += e.episode_return;
+    successes += e.success;
+  }
+  const double n = static_cast<double>(episodes.size());
+  std::printf("%zu test episodes: success rate %.1f %% (%d/%zu), mean return %.3f\n",
+              episodes.size(), 100.0 * successes / n, successes, episodes.size(), returns / n);
   if (o.render_video) std::printf("videos: %s/episode_<i>.mp4\n", dir.c_str());
 }
 

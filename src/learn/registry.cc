@@ -1,6 +1,7 @@
 #include "learn/registry.h"
 
 #include "core/error.h"
+#include "core/text.h"
 #include "learn/a2c.h"
 #include "learn/ddpg.h"
 #include "learn/meta/sami_learner.h"
@@ -29,15 +30,6 @@ constexpr Algorithm kAlgorithms[] = {
     {"ddpg", make_ddpg, {.data_parallel = true}},
 };
 
-// "a, b, c <last> d".
-std::string join(const std::vector<std::string>& names, std::string_view last) {
-  std::string out;
-  for (size_t k = 0; k < names.size(); ++k) {
-    out += (k == 0 ? "" : k + 1 == names.size() ? " " + std::string(last) + " " : ", ") + names[k];
-  }
-  return out;
-}
-
 [[noreturn]] void unknown(std::string_view algorithm) {
   throw UserError("unknown algorithm '" + std::string(algorithm) + "' (expected " +
                   algorithm_list() + ")");
@@ -64,14 +56,14 @@ AlgorithmTraits algorithm_traits(std::string_view algorithm) {
   unknown(algorithm);
 }
 
-std::string algorithm_list() { return join(algorithm_names(), "or"); }
+std::string algorithm_list() { return listed(algorithm_names()); }
 
 std::string algorithms_with(bool AlgorithmTraits::*trait, std::string_view last) {
   std::vector<std::string> names;
   for (const std::string& name : algorithm_names()) {
     if (algorithm_traits(name).*trait) names.push_back(name);
   }
-  return join(names, last);
+  return listed(names, last);
 }
 
 std::vector<std::string> extra_report_keys(std::string_view algorithm) {

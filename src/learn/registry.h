@@ -25,8 +25,8 @@ std::unique_ptr<Learner> make_learner(std::string_view algorithm, VecEnv& env,
 
 // What an algorithm can do besides training on one process's vector of envs.
 struct AlgorithmTraits {
-  bool data_parallel =
-      false;  // --distributed: gradients averaged over ranks (LearnerOptions::sync)
+  // --distributed: gradients averaged over ranks (LearnerOptions::sync)
+  bool data_parallel = false;
   bool async_collection = false;  // --async-batch: collects from an AsyncVecEnv in batches
 };
 // UserError naming the algorithms for an unknown name.

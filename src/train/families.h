@@ -23,7 +23,7 @@ struct Family {
   // parameters (never empty here) with the family's facts (return bounds, easy region, what the
   // teacher hears).
   CurriculumSpec (*curriculum)(const envs::EnvSpec& env) = nullptr;
-  // What the family's own tools write in a run folder, by name (one '*' for any text): SaMI's
+  // What the family's own tools write in a run folder, by shell pattern (fnmatch): SaMI's
   // evaluations, and an earlier version's checkpoint and progress files. A folder holding one
   // holds a run, and --overwrite removes them with it.
   std::vector<std::string> outputs;

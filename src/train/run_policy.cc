@@ -64,10 +64,8 @@ RunInfo read_run_info(const fs::path& run_folder) {
   j.string_map("hyperparameters");  // checked: the checkpoint holds the values the run used
   const std::vector<std::string>& algorithms = learn::algorithm_names();
   if (std::find(algorithms.begin(), algorithms.end(), run.algorithm) == algorithms.end()) {
-    std::string known;
-    for (const std::string& a : algorithms) known += (known.empty() ? "" : ", ") + a;
     throw UserError(j.where() + ": \"algorithm\" is \"" + run.algorithm + "\"; expected one of " +
-                    known);
+                    learn::algorithm_list());
   }
   if (env == kBabyBenchConfigRun) {
     if (run.family != "babybench") {

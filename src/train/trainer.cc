@@ -1,5 +1,7 @@
 #include "train/trainer.h"
 
+#include <fnmatch.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -121,14 +123,6 @@ bool pool_progress(GradSync& sync, TrainStats& stats, EpisodeTally& tally, bool 
   stats.episodic_length = sums[0] > 0 ? sums[2] / sums[0] : std::nan("");
   tally = {sums[3], sums[4], sums[5], sums[6]};
   return sums[7] > 0;
-}
-
-// Whether a file name is `pattern`, where one '*' stands for any text ("eval_*.json").
-bool name_matches(const std::string& name, const std::string& pattern) {
-  const size_t star = pattern.find('*');
-  if (star == std::string::npos) return name == pattern;
-  return name.size() + 1 >= pattern.size() && name.starts_with(pattern.substr(0, star)) &&
-         name.ends_with(pattern.substr(star + 1));
 }
 
 // What a run left in `dir` (its latest checkpoint, or its progress rows); empty when none.
@@ -386,7 +380,9 @@ void open_run_folder(Run& run) {
       patterns.insert(patterns.end(), {"evaluation*.json", "videos"});
       for (const auto& entry : fs::directory_iterator(run.dir, ec)) {
         const std::string name = entry.path().filename().string();
-        if (std::ranges::any_of(patterns, [&](const auto& p) { return name_matches(name, p); })) {
+        if (std::ranges::any_of(patterns, [&](const auto& p) {
+              return fnmatch(p.c_str(), name.c_str(), 0) == 0;
+            })) {
           if (held.empty()) held = entry.path();
           removed.push_back(name);
         }

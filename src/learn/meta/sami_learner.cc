@@ -19,6 +19,7 @@
 
 #include "core/error.h"
 #include "core/rng.h"
+#include "core/text.h"
 #include "learn/checkpoint.h"
 #include "learn/grad_tensors.h"
 #include "learn/meta/context_sac.h"
@@ -437,12 +438,7 @@ TrainStats SamiLearner::report(Clock::time_point start, long start_steps) {
 
 std::span<const std::string_view> sami_learner_names() { return kNames; }
 
-std::string sami_learner_list() {
-  std::string out;
-  for (size_t k = 0; k < kNames.size(); ++k)
-    out += (k == 0 ? "" : k + 1 == kNames.size() ? " or " : ", ") + std::string(kNames[k]);
-  return out;
-}
+std::string sami_learner_list() { return listed(kNames); }
 
 std::string_view sami_method(std::string_view algorithm) {
   for (size_t k = 0; k < kNames.size(); ++k) {
